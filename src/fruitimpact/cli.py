@@ -1,0 +1,281 @@
+"""Command-line interface: ``fruitimpact simulate | paper | ...``.
+
+Bad input is answered with one line on stderr naming the argument and its
+allowed range, exit status 2, never a traceback.  Heavy imports (matplotlib,
+pandas, scipy) happen only in the subcommands that need them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import sys
+
+from .units import parse_quantity
+
+PROG = "fruitimpact"
+
+
+class UsageError(Exception):
+    """Bad command-line input: printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, no usage block
+        raise UsageError(message)
+
+
+# (option, dimension, help) of the impact inputs; option names are a contract.
+IMPACT_OPTIONS = (
+    ("--mass", "mass", "fruit mass M (e.g. 115g) [kg]"),
+    ("--diameter", "length", "fruit diameter d (e.g. 65mm) [m]"),
+    ("--modulus", "modulus", "Young's modulus E of the flesh (e.g. 3MPa) [Pa]"),
+    ("--poisson", "dimensionless", "Poisson's ratio ν, in (-1, 0.5)"),
+    ("--stiffness", "stiffness", "contact stiffness k_c [N/m^1.5]; overrides E, ν, d (eq 9)"),
+    ("--velocity", "velocity", "impact velocity V_i (e.g. 1m/s) [m/s]"),
+    ("--drop-height", "length", "drop height h instead of --velocity (e.g. 30cm) [m]"),
+    ("--restitution", "dimensionless", "restitution coefficient k, in (0, 1]"),
+    ("--alpha", "alpha", "Hunt-Crossley α instead of k, k = 1 - α V_i (eq 6) [s/m]"),
+)
+
+
+def _dest(option: str) -> str:
+    return option.lstrip("-").replace("-", "_")
+
+
+def _quantities(args, options=IMPACT_OPTIONS) -> dict:
+    """Parse the unit-bearing options; a bad one raises UsageError naming it."""
+    values = {}
+    for option, dimension, _ in options:
+        text = getattr(args, _dest(option), None)
+        if text is None:
+            continue
+        try:
+            values[_dest(option)] = parse_quantity(text, dimension)
+        except ValueError as exc:
+            raise UsageError(f"argument {option}: {exc}") from None
+    return values
+
+
+def _library_call(func, *args, **kwargs):
+    """Run a library call, turning its ValueError into the CLI's one-line error."""
+    try:
+        return func(*args, **kwargs)
+    except ValueError as exc:
+        raise UsageError(_with_option(str(exc))) from None
+
+
+def _with_option(message: str) -> str:
+    """Prefix a library message with the CLI option it concerns ("mass ..." → "argument --mass: mass ...")."""
+    if message.startswith("give either"):  # a conflict: name both options as typed
+        words = message.split()
+        return f"give either --{words[2].replace('_', '-')} or --{words[4].rstrip(',').replace('_', '-')}, not both"
+    name = message.split(" ", 1)[0]
+    option = "--" + name.replace("_", "-")
+    known = {o for o, _, _ in IMPACT_OPTIONS} | {"--model", "--calibration", "--method", "--step"}
+    if option in known:
+        return f"argument {option}: {message}"
+    return message
+
+
+def _add_impact_options(parser: argparse.ArgumentParser) -> None:
+    from .models import CALIBRATIONS, DAMPING_LAWS
+    from .solvers import SOLVERS
+
+    group = parser.add_argument_group("fruit and impact (plain numbers are SI; units accepted)")
+    for option, _, text in IMPACT_OPTIONS:
+        group.add_argument(option, metavar="VALUE", help=text)
+    group.add_argument("--model", default="hunt-crossley", metavar="{" + ",".join(DAMPING_LAWS) + "}",
+                       help="damping law (default hunt-crossley)")
+    group.add_argument("--calibration", default="exact", metavar="{" + ",".join(CALIBRATIONS) + "}",
+                       help="exact: λ gives exactly the requested k (default); paper: the law's formula")
+    group.add_argument("--method", default="accurate", metavar="{" + ",".join(SOLVERS) + "}",
+                       help="accurate (default) or rk4, the paper's fixed-step method")
+    group.add_argument("--step", default="1e-4", metavar="VALUE", help="RK4 time step (default 1e-4 s) [s]")
+
+
+def _simulate_kwargs(args) -> dict:
+    from .impact import Fruit
+
+    values = _quantities(args)
+    try:
+        step = parse_quantity(args.step, "time")
+    except ValueError as exc:
+        raise UsageError(f"argument --step: {exc}") from None
+    fruit_fields = {k: values[k] for k in ("mass", "diameter", "modulus", "poisson", "stiffness") if k in values}
+    fruit = _library_call(Fruit, **fruit_fields)
+    return dict(fruit=fruit, velocity=values.get("velocity"), drop_height=values.get("drop_height"),
+                restitution=values.get("restitution"), alpha=values.get("alpha"), model=args.model,
+                calibration=args.calibration, method=args.method, step=step)
+
+
+# --------------------------------------------------------------------------- tables
+TABLE_ROWS = (
+    ("peak force F_max", "peak_force", 1.0, "N"),
+    ("time to peak t_c", "time_to_peak", 1e3, "ms"),
+    ("contact duration T", "contact_duration", 1e3, "ms"),
+    ("max deflection δ_max", "max_deflection", 1e3, "mm"),
+    ("time to max deflection", "time_to_max_deflection", 1e3, "ms"),
+    ("exit velocity", "exit_velocity", 1.0, "m/s"),
+    ("restitution e", "restitution", 1.0, ""),
+    ("absorbed energy", "absorbed_energy", 1e3, "mJ"),
+    ("firmness C = F_max/t_c", "firmness_c", 1e-3, "N/ms"),
+    ("firmness C* = F_max/t_c²", "firmness_c_star", 1e-6, "N/ms²"),
+    ("max contact pressure", "max_pressure", 1e-6, "MPa"),
+    ("contact radius a", "contact_radius", 1e3, "mm"),
+)
+
+
+def format_result_table(result) -> str:
+    """A readable table of one result's inputs and characteristics."""
+    inputs = result.inputs
+    fruit = inputs.fruit
+    c = result.characteristics
+    lines = [
+        f"fruit      M = {fruit.mass * 1e3:.4g} g, d = {fruit.diameter * 1e3:.4g} mm, "
+        f"E = {fruit.modulus / 1e6:.4g} MPa, ν = {fruit.poisson:.4g}",
+        f"impact     V_i = {inputs.velocity:.4g} m/s"
+        + (f" (drop {inputs.drop_height * 100:.4g} cm)" if inputs.drop_height is not None else "")
+        + f", target k = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else "",
+        f"law        {inputs.model}, calibration {inputs.calibration}, method {inputs.method}"
+        + (f" (step {inputs.step:g} s)" if inputs.method == "rk4" else ""),
+        f"contact    k_c = {result.law.stiffness / 1e6:.5g}e6 N/m^1.5, λ = {result.law.damping / 1e6:.5g}e6 N·s/m^2.5"
+        f" (c = λ/k_c = {result.law.damping_factor:.5g} s/m)",
+        "",
+        f"{'characteristic':<28}{'value':>14}  unit",
+        f"{'-' * 28}{'-' * 14}  {'-' * 6}",
+    ]
+    for label, key, scale, unit in TABLE_ROWS:
+        lines.append(f"{label:<28}{getattr(c, key) * scale:>14.6g}  {unit}")
+    if not math.isnan(c.max_deflection_closed_form):
+        lines += ["", "closed-form self-check (first integral of the force law):",
+                  f"  δ_max = {c.max_deflection_closed_form * 1e3:.9g} mm "
+                  f"(relative difference {c.max_deflection / c.max_deflection_closed_form - 1:+.1e})",
+                  f"  e     = {c.restitution_closed_form:.9g} "
+                  f"(relative difference {c.restitution / c.restitution_closed_form - 1:+.1e})"]
+    if not result.success:
+        lines += ["", f"FAILED: {result.message}"]
+    return "\n".join(lines)
+
+
+def _json_default(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return str(value)
+
+
+def _finite(obj):
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def dump_json(obj) -> str:
+    """JSON with NaN/inf written as null (strict JSON)."""
+    return json.dumps(_finite(obj), indent=2, default=_json_default, allow_nan=False)
+
+
+# --------------------------------------------------------------------------- commands
+def cmd_simulate(args) -> int:
+    from .impact import simulate
+
+    kwargs = _simulate_kwargs(args)
+    result = _library_call(simulate, **kwargs)
+    if args.csv:
+        result.curves.to_csv(args.csv)
+    if args.plot:
+        from .plotting import impact_figure, save_figure
+
+        save_figure(impact_figure(result, title="fruitimpact: impact of the fruit on the surface"), args.plot)
+    if args.json:
+        print(dump_json(result.to_dict()))
+    else:
+        print(format_result_table(result))
+        for what, path in (("curves", args.csv), ("figure", args.plot)):
+            if path:
+                print(f"{what} written to {path}")
+    return 0 if result.success else 1
+
+
+def cmd_paper(args) -> int:
+    from .paper import paper_report, format_paper_report
+
+    report = paper_report()
+    if args.figures:
+        from .paper import write_paper_figures
+
+        report["figures"] = write_paper_figures(args.figures)
+    if args.json:
+        print(dump_json(report))
+    else:
+        print(format_paper_report(report))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    sim = sub.add_parser("simulate", help="simulate one impact (default: the paper's Jonathan apple)",
+                         description="Simulate one impact; defaults are the paper's Jonathan apple "
+                                     "(M = 115 g, d = 65 mm, E = 3 MPa, ν = 0.37, k = 0.577, V_i = 1 m/s).")
+    _add_impact_options(sim)
+    out = sim.add_argument_group("output")
+    out.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of a table")
+    out.add_argument("--csv", metavar="FILE", help="write the curves t, δ, δ̇, F as CSV")
+    out.add_argument("--plot", metavar="FILE", help="write the four-panel figure (PNG/SVG/PDF by extension)")
+    sim.set_defaults(func=cmd_simulate)
+
+    pap = sub.add_parser("paper", help="reproduce the founding paper's Table 1 and worked example")
+    pap.add_argument("--json", action="store_true", help="print everything as JSON")
+    pap.add_argument("--figures", metavar="DIR", help="write the worked example's figures to DIR")
+    pap.set_defaults(func=cmd_paper)
+    return parser
+
+
+_NEGATIVE = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+
+
+def _attach_negative_values(argv: list[str]) -> list[str]:
+    """Let "--drop-height -3cm" reach our range check instead of argparse's
+    "expected one argument": glue a value that starts with "-<digit>" to its option."""
+    glued = []
+    i = 0
+    while i < len(argv):
+        token = argv[i]
+        if (token.startswith("--") and "=" not in token and i + 1 < len(argv)
+                and _NEGATIVE.match(argv[i + 1])):
+            glued.append(f"{token}={argv[i + 1]}")
+            i += 2
+            continue
+        glued.append(token)
+        i += 1
+    return glued
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    argv = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
+    try:
+        args = parser.parse_args(argv)
+        if getattr(args, "func", None) is None:
+            parser.print_help()
+            return 2
+        return args.func(args)
+    except UsageError as exc:
+        command = getattr(locals().get("args"), "command", None)
+        prefix = f"{PROG} {command}" if command else PROG
+        print(f"{prefix}: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # e.g. piped into head
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,47 @@
+"""Contact force families as compiled functions of (δ, δ̇).
+
+Each family is an integer code with a fixed parameter vector, so that one
+compiled integrator serves them all.  The friendly registry of named models
+(``fruitimpact.models``) maps each published model onto one of these.
+All forces are in N, δ in m (positive in compression), δ̇ in m/s (positive
+while approaching).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+
+#: F = K δ^n (1 + c δ̇); params (K [N/m^n], n [-], c [s/m]).  Hunt & Crossley 1975.
+POWER_LAW = 0
+#: F = k δ + b δ̇; params (k [N/m], b [N·s/m]).  Linear Kelvin–Voigt spring–dashpot.
+KELVIN_VOIGT = 1
+#: F = K (δ^1.5 + B δ^0.5 δ̇); params (K [N/m^1.5], B [s]).  Kuwabara & Kono 1987, Brilliantov et al. 1996.
+KUWABARA_KONO = 2
+#: F = K δ^1.5 + η δ^0.25 δ̇; params (K [N/m^1.5], η [N·s/m^1.25]).  Tsuji, Tanaka & Ishida 1992.
+TSUJI = 3
+
+_JIT = dict(cache=True, error_model="numpy")
+
+
+@nb.njit(**_JIT)
+def contact_force(family, params, deflection, rate, clamp):
+    """Contact force [N] of ``family`` at deflection δ and rate δ̇.
+
+    With ``clamp`` the force is never tensile (max(F, 0)): a fruit cannot
+    pull on the surface.  δ ≤ 0 means no contact and no force."""
+    if deflection <= 0.0:
+        return 0.0
+    if family == POWER_LAW:
+        force = params[0] * deflection ** params[1] * (1.0 + params[2] * rate)
+    elif family == KELVIN_VOIGT:
+        force = params[0] * deflection + params[1] * rate
+    elif family == KUWABARA_KONO:
+        root = math.sqrt(deflection)
+        force = params[0] * root * (deflection + params[1] * rate)
+    else:  # TSUJI
+        force = params[0] * deflection * math.sqrt(deflection) + params[1] * math.sqrt(math.sqrt(deflection)) * rate
+    if clamp and force < 0.0:
+        return 0.0
+    return force

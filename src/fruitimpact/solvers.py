@@ -1,0 +1,124 @@
+"""Solvers behind one interface: ``accurate`` (exact) and ``rk4`` (the paper's).
+
+Each solver turns a resolved force law, a mass, an impact velocity and an
+effective radius into the characteristics (``engine.powerlaw.CHARACTERISTIC_COLUMNS``)
+and into curves.  Failures come back as ``success = False`` with a message,
+never as an exception in the middle of a sweep.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .engine import forces
+from .engine.powerlaw import (N_CHARACTERISTICS, powerlaw_curves, powerlaw_single, r_func,
+                              restitution_of_x)
+from .engine.rk4 import rk4_impact
+
+#: Safety limit on RK4 steps for one impact.
+RK4_MAX_STEPS = 2_000_000
+
+
+def closed_forms(law, mass: float, velocity: float) -> tuple[float, float]:
+    """(δ_max [m], e) from the first integral of F = K δ^n (1 + c δ̇):
+    δ_max = [(n+1) m (x - ln(1+x)) / (K c²)]^(1/(n+1)), x = c v0, and e the root
+    of (1 + x) = (1 - e x) exp((1 + e) x) (Hunt & Crossley 1975; docs/physics.md).
+    NaN for other force families."""
+    if law.family != forces.POWER_LAW:
+        return math.nan, math.nan
+    n = law.exponent
+    x = law.damping_factor * velocity
+    # (x - ln(1+x))/c² = v0² r(x), written through r to stay exact as c → 0
+    max_deflection = ((n + 1.0) * mass * velocity ** 2 * r_func(x) / law.stiffness) ** (1.0 / (n + 1.0))
+    return max_deflection, restitution_of_x(x)
+
+
+def _accurate_characteristics(law, mass, velocity, radius, step):
+    if law.family != forces.POWER_LAW:
+        raise NotImplementedError("accurate solver: only the power-law family in this version")
+    values = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, radius)
+    if not np.all(np.isfinite(values[:10])):
+        return tuple(values), False, "accurate solver produced non-finite characteristics"
+    return tuple(float(v) for v in values), True, "ok"
+
+
+def _accurate_curves(law, mass, velocity, step, points):
+    duration = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, 1.0)[2]
+    times = np.linspace(0.0, duration, int(points))
+    deflection, rate, force, _ = powerlaw_curves(mass, law.stiffness, law.damping_factor, velocity,
+                                                 times, law.exponent)
+    return times, deflection, rate, force
+
+
+def _rk4_run(law, mass, velocity, radius, step, store):
+    # the contact lasts a few Hertz times; the step limit only guards runaway input
+    max_steps = RK4_MAX_STEPS
+    size = max_steps + 2 if store else 1
+    if store:
+        estimate = 40.0 * ((1.25 * mass * velocity ** 2 / law.stiffness) ** 0.4 / velocity) / step
+        size = int(min(max_steps, max(estimate, 1000))) + 2
+        max_steps = size - 2
+    arrays = [np.empty(size) for _ in range(4)]
+    out = np.empty(N_CHARACTERISTICS)
+    count = rk4_impact(law.family, law.params(), law.clamp, mass, velocity, radius, step,
+                       max_steps, store, *arrays, out)
+    return count, arrays, out
+
+
+def _rk4_characteristics(law, mass, velocity, radius, step):
+    count, _, out = _rk4_run(law, mass, velocity, radius, step, False)
+    if count < 0:
+        return tuple(out), False, f"rk4: contact did not end within {RK4_MAX_STEPS} steps of {step:g} s"
+    return tuple(float(v) for v in out), True, "ok"
+
+
+def _rk4_curves(law, mass, velocity, step, points):
+    count, (t, d, v, f), _ = _rk4_run(law, mass, velocity, 1.0, step, True)
+    if count < 0:
+        raise RuntimeError(f"rk4: contact did not end within the step limit at step {step:g} s")
+    return t[:count].copy(), d[:count].copy(), v[:count].copy(), f[:count].copy()
+
+
+@dataclass(frozen=True)
+class Solver:
+    """A way to integrate one impact.
+
+    characteristics(law, mass, velocity, radius, step) -> (values, success, message)
+    curves(law, mass, velocity, step, points) -> (t, δ, δ̇, F)
+    """
+
+    name: str
+    description: str
+    characteristics: Callable
+    curves: Callable
+    closed_forms: Callable = closed_forms
+
+
+SOLVERS: dict[str, Solver] = {
+    "accurate": Solver(
+        name="accurate",
+        description=("exact: characteristics from the first integral and Gauss-Jacobi quadrature of the "
+                     "contact time; curves by exact inversion of t(δ̇) (agrees with closed forms to ~1e-12)"),
+        characteristics=_accurate_characteristics,
+        curves=_accurate_curves,
+    ),
+    "rk4": Solver(
+        name="rk4",
+        description=("the paper's method: classical Runge-Kutta at a fixed step; peaks are grid samples, the "
+                     "end of contact is interpolated inside the last step"),
+        characteristics=_rk4_characteristics,
+        curves=_rk4_curves,
+    ),
+}
+
+
+def get_solver(name: str) -> Solver:
+    """The solver registered as ``name``; ValueError naming the choices otherwise."""
+    try:
+        return SOLVERS[name]
+    except KeyError:
+        raise ValueError(f"method must be one of {', '.join(SOLVERS)}; got {name!r}") from None
