@@ -27,12 +27,14 @@ _JIT = dict(cache=True, error_model="numpy")
 
 @nb.njit(**_JIT)
 def contact_force(family, params, deflection, rate, clamp):
-    """Contact force [N] of ``family`` at deflection δ and rate δ̇.
+    """Contact force [N] of ``family`` at deflection δ and rate δ̇, in contact.
 
-    With ``clamp`` the force is never tensile (max(F, 0)): a fruit cannot
-    pull on the surface.  δ ≤ 0 means no contact and no force."""
-    if deflection <= 0.0:
-        return 0.0
+    The caller decides when contact ends; here δ < 0 (an integrator stage just
+    past separation) counts as δ = 0, so that a law with a dashpot term, like
+    Kelvin–Voigt, has its force b·δ̇ at first touch.  With ``clamp`` the force
+    is never tensile (max(F, 0)): a fruit cannot pull on the surface."""
+    if deflection < 0.0:
+        deflection = 0.0
     if family == POWER_LAW:
         force = params[0] * deflection ** params[1] * (1.0 + params[2] * rate)
     elif family == KELVIN_VOIGT:
