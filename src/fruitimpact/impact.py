@@ -290,7 +290,8 @@ def prepare(fruit: Fruit | None = None, *, velocity=None, drop_height=None, rest
         velocity = JONATHAN_VELOCITY
     velocity = check_positive("velocity", velocity, "m/s")
     if alpha is not None:
-        alpha = check_range("alpha", alpha, 0.0, 1.0 / velocity, unit="s/m (e = 1 - alpha*V_i must be > 0)")
+        alpha = check_range("alpha", alpha, 0.0, 1.0 / velocity, low_inclusive=True,
+                            unit="s/m (so that k = 1 - alpha*V_i is in (0, 1])")
         target = 1.0 - alpha * velocity
     else:
         if restitution is None:

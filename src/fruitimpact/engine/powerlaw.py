@@ -343,7 +343,8 @@ def _curves_kernel(mass, stiffness, n, damping_factor, velocity, times,
             zeta = _invert_time(x, p, r_x, duration - t, zeta0, 0.0, time_scale,
                                 lo_nodes, lo_weights, False)
         dphi = delta_phi(x, zeta, r_x)
-        d = delta_h * (2.0 * dphi) ** (1.0 / (n + 1.0)) if dphi > 0.0 else 0.0
+        # exactly zero at the ends: ΔΦ there is a rounding residue, amplified by the power 1/(n+1)
+        d = delta_h * (2.0 * dphi) ** (1.0 / (n + 1.0)) if (dphi > 0.0 and 0.0 < t < duration) else 0.0
         deflection[i] = d
         rate[i] = velocity * zeta * e1_func(x * zeta)
         force[i] = stiffness * d ** n * math.exp(x * zeta)
