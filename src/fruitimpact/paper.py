@@ -269,7 +269,7 @@ def format_paper_report(report: dict) -> str:
         lines.append(f"{e['case']:>2} {e['law']:<14} {r['target']:>8.3f}   {r['paper_calibration']:>17.4f}   "
                      f"{r['exact_calibration']:>17.6f}   {r['damping_ratio_needed']:>15.2f}")
     lines += ["  The paper's calibrations are first order in (1 - k); for apples (k ≈ 0.5-0.64) they give a",
-              "  restitution 0.11-0.23 too high.  The exact calibration solves (1+x) = (1-kx) exp((1+k)x), x = c V_i.",
+              "  restitution 0.09-0.23 too high.  The exact calibration solves (1+x) = (1-kx) exp((1+k)x), x = c V_i.",
               "", "Details and sources: docs/paper.md"]
     return "\n".join(lines)
 
