@@ -172,6 +172,14 @@ def test_alpha_sets_target_restitution_one_minus_alpha_v(capsys, argv, velocity,
     assert result["restitution"] == pytest.approx(target, abs=1e-8)  # exact calibration by default
 
 
+def test_alpha_zero_is_elastic(capsys):
+    """α = 0 is k = 1 (the closed end of the range, like --restitution 1)."""
+    result = run_json(capsys, "--alpha", "0")
+    assert result["target_restitution"] == 1.0
+    assert result["restitution"] == pytest.approx(1.0, abs=1e-12)
+    assert result["damping"] == 0.0
+
+
 def test_alpha_with_paper_calibration_is_hunt_crossley_eq6(capsys):
     """Paper calibration of hunt-crossley: λ = (3/2) α k_c (eqs 5, 6, 11)."""
     result = run_json(capsys, "--alpha", "0.3", "--velocity", "1.2", "--calibration", "paper")
@@ -265,11 +273,11 @@ def test_hertz_closed_forms(capsys, argv):
 
 
 # --------------------------------------------------------------------------- CSV
-def _read_csv(path: Path):
+def _read_csv(path: Path, min_rows: int = 100):
     lines = path.read_text().splitlines()
     assert lines[0] == "time_s,deflection_m,rate_m_per_s,force_N"
     data = np.loadtxt(path, delimiter=",", skiprows=1)
-    assert data.ndim == 2 and data.shape[1] == 4 and data.shape[0] > 100
+    assert data.ndim == 2 and data.shape[1] == 4 and data.shape[0] > min_rows
     assert np.all(np.isfinite(data))
     return data.T
 
@@ -282,7 +290,8 @@ def test_csv_curves_match_characteristics(capsys, tmp_path):
     ½·|F''|·(h/2)², h the sample spacing, because the grid point nearest to
     t_c lies within h/2 of it and F'(t_c) = 0.  |F''| is estimated from second
     differences of the samples near the peak (with a factor 2 of safety); for
-    the 1001-point default this is ~1e-6 relative.
+    the 1001-point default the bound is ~2e-5 relative (the actual shortfall
+    is ~1e-8).
     """
     path = tmp_path / "curves.csv"
     r = run_json(capsys, "--csv", path)
@@ -309,7 +318,7 @@ def test_csv_rk4_peak_is_a_grid_sample(capsys, tmp_path):
     """RK4 reads F_max off its own grid, so the CSV maximum equals it to the CSV's 12 digits."""
     path = tmp_path / "rk4.csv"
     r = run_json(capsys, "--method", "rk4", "--step", "1e-4", "--csv", path)
-    t, _, _, force = _read_csv(path)
+    t, _, _, force = _read_csv(path, min_rows=50)  # 6.3 ms contact at 0.1 ms
     assert np.allclose(np.diff(t)[:-1], 1e-4, rtol=1e-9, atol=0)  # fixed step (last may be partial)
     assert force.max() == pytest.approx(r["peak_force"], rel=1e-11)
     assert t[int(np.argmax(force))] == pytest.approx(r["time_to_peak"], rel=1e-11)
@@ -408,14 +417,14 @@ BAD_CASES += [
     (["--velocity", "1", "--drop-height", "30cm"], ["--velocity", "--drop-height"], ["not both"]),
     (["--drop-height", "0.3", "--velocity", "2m/s"], ["--velocity", "--drop-height"], ["not both"]),
     (["--restitution", "0.5", "--alpha", "0.1"], ["--restitution", "--alpha"], ["not both"]),
-    # alpha with k = 1 - α V_i ≤ 0 (or > 1)
-    (["--alpha", "1"], ["--alpha"], ["(0, 1)", "1 - alpha*V_i"]),
-    (["--alpha", "2"], ["--alpha"], ["(0, 1)", "1 - alpha*V_i"]),
-    (["--velocity", "2", "--alpha", "0.5"], ["--alpha"], ["(0, 0.5)", "1 - alpha*V_i"]),
-    (["--velocity", "4", "--alpha", "0.3"], ["--alpha"], ["(0, 0.25)", "1 - alpha*V_i"]),
-    (["--drop-height", "1m", "--alpha", "0.5"], ["--alpha"], [f"(0, {1 / math.sqrt(2 * G):g})"]),
-    (["--alpha", "-0.1"], ["--alpha"], ["(0, 1)"]),
-    (["--alpha", "nan"], ["--alpha"], ["(0, 1)"]),
+    # alpha with k = 1 - α V_i ≤ 0 (or > 1): the message states the upper bound 1/V_i
+    (["--alpha", "1"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
+    (["--alpha", "2"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
+    (["--velocity", "2", "--alpha", "0.5"], ["--alpha"], [", 0.5)", "1 - alpha*V_i"]),
+    (["--velocity", "4", "--alpha", "0.3"], ["--alpha"], [", 0.25)", "1 - alpha*V_i"]),
+    (["--drop-height", "1m", "--alpha", "0.5"], ["--alpha"], [f", {1 / math.sqrt(2 * G):g})"]),
+    (["--alpha", "-0.1"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
+    (["--alpha", "nan"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
 ]
 
 

@@ -1,0 +1,166 @@
+"""fruitimpact benchmarks: one command, baselines in the same run.
+
+    python benchmarks/run.py [--quick] [--markdown FILE]
+
+Each line compares fruitimpact with the obvious baseline doing the same job:
+SciPy ``solve_ivp`` (DOP853, rtol 1e-10, terminal event at δ = 0, peak force by
+a root of dF/dt on the dense output) and the paper's RK4 at 1e-4 s.  Accuracy
+is measured against a tight reference (DOP853 at rtol 1e-12) on a sample.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from fruitimpact import simulate
+from fruitimpact.engine import forces
+from fruitimpact.engine.powerlaw import (CHARACTERISTIC_COLUMNS, exact_x, powerlaw_characteristics,
+                                         powerlaw_single)
+from fruitimpact.engine.rk4 import rk4_batch
+
+KEYS = ("peak_force", "time_to_peak", "contact_duration", "max_deflection", "restitution")
+COL = [CHARACTERISTIC_COLUMNS.index(k) for k in KEYS]
+
+
+def scipy_impact(mass, stiffness, damping_factor, velocity, rtol=1e-10):
+    """The baseline: what a user would write with SciPy for the same characteristics."""
+    k, c, m = stiffness, damping_factor, mass
+
+    def rhs(t, y):
+        d = max(y[0], 0.0)
+        return [y[1], -k * d ** 1.5 * (1.0 + c * y[1]) / m]
+
+    def separation(t, y):
+        return y[0] if t > 0 else 1.0
+
+    separation.terminal = True
+    separation.direction = -1
+    t_end = 50.0 * ((1.25 * m * velocity ** 2 / k) ** 0.4) / velocity
+    sol = solve_ivp(rhs, [0.0, t_end], [0.0, velocity], method="DOP853", rtol=rtol,
+                    atol=[rtol * 1e-3 * velocity * t_end, rtol * 1e-3 * velocity], events=separation,
+                    dense_output=True)
+    duration = sol.t_events[0][0]
+    exit_rate = sol.y_events[0][0][1]
+
+    def force_rate(t):
+        d, v = sol.sol(t)
+        d = max(d, 1e-300)
+        acc = -k * d ** 1.5 * (1.0 + c * v) / m
+        return k * 1.5 * d ** 0.5 * v * (1.0 + c * v) + k * d ** 1.5 * c * acc
+
+    t_max = brentq(lambda t: sol.sol(t)[1], 1e-3 * duration, 0.999 * duration, xtol=1e-15)
+    t_peak = brentq(force_rate, 1e-4 * duration, t_max, xtol=1e-15) if c > 0 else t_max
+    d_peak, v_peak = sol.sol(t_peak)
+    return np.array([k * d_peak ** 1.5 * (1 + c * v_peak), t_peak, duration, sol.sol(t_max)[0],
+                     -exit_rate / velocity])
+
+
+def population(rows, seed=1):
+    rng = np.random.default_rng(seed)
+    mass = rng.uniform(0.08, 0.3, rows)
+    stiffness = rng.uniform(4e5, 2e6, rows)
+    velocity = rng.uniform(0.3, 3.0, rows)
+    restitution = rng.uniform(0.3, 0.9, rows)
+    damping_factor = exact_x(restitution) / velocity
+    return mass, stiffness, damping_factor, velocity
+
+
+def best_of(func, repeats=5):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def max_rel_error(values, reference):
+    return float(np.max(np.abs(values / reference - 1.0)))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="smaller sizes (for a smoke run)")
+    parser.add_argument("--markdown", metavar="FILE", help="also write the table as Markdown")
+    args = parser.parse_args(argv)
+    rows = []
+
+    def record(task, fruitimpact_value, baseline_name, baseline_value, unit, note):
+        ratio = baseline_value / fruitimpact_value if unit.startswith("µs") or unit == "s" else fruitimpact_value / baseline_value
+        rows.append((task, fruitimpact_value, baseline_name, baseline_value, unit, ratio, note))
+        print(f"{task:<52} {fruitimpact_value:>12.4g} {unit:<12} | {baseline_name:<28} {baseline_value:>12.4g}  "
+              f"speed-up {ratio:,.0f}×  {note}", flush=True)
+
+    apple = dict(mass=0.115, stiffness=0.8355e6, damping_factor=1.0678, velocity=1.0)
+    # ------------------------------------------------------------------ single impacts
+    simulate()  # warm-up: load compiled kernels
+    n_api = 2000 if args.quick else 20000
+    api = best_of(lambda: [simulate() for _ in range(n_api)], 3) / n_api * 1e6
+    n_scipy = 20 if args.quick else 200
+    scipy_single = best_of(lambda: [scipy_impact(**apple) for _ in range(n_scipy)], 3) / n_scipy * 1e6
+    record("one accurate impact, Python API simulate()", api, "solve_ivp DOP853 1e-10", scipy_single, "µs/impact",
+           "all characteristics + closed-form check")
+    engine = best_of(lambda: [powerlaw_single(0.115, 0.8355e6, 1.5, 1.0678, 1.0, 0.0325) for _ in range(n_api)], 3)
+    record("one accurate impact, engine call", engine / n_api * 1e6, "solve_ivp DOP853 1e-10", scipy_single,
+           "µs/impact", "")
+    simulate(method="rk4")
+    rk4_api = best_of(lambda: [simulate(method="rk4") for _ in range(n_api // 4)], 3) / (n_api // 4) * 1e6
+    record("one RK4 impact (paper, 1e-4 s), Python API", rk4_api, "solve_ivp DOP853 1e-10", scipy_single,
+           "µs/impact", "~63 steps")
+
+    # ------------------------------------------------------------------ batch
+    n_batch = 200_000 if args.quick else 2_000_000
+    m, k, c, v = population(n_batch)
+    powerlaw_characteristics(m[:10], k[:10], c[:10], v[:10], 0.03, parallel=True)
+    batch = best_of(lambda: powerlaw_characteristics(m, k, c, v, 0.03), 3)
+    n_ref = 50 if args.quick else 300
+    start = time.perf_counter()
+    ref = np.array([scipy_impact(m[i], k[i], c[i], v[i], rtol=1e-10) for i in range(n_ref)])
+    scipy_rate = n_ref / (time.perf_counter() - start)
+    tight = np.array([scipy_impact(m[i], k[i], c[i], v[i], rtol=1e-12) for i in range(n_ref)])
+    ours = powerlaw_characteristics(m[:n_ref], k[:n_ref], c[:n_ref], v[:n_ref], 0.03)[:, COL]
+    err = max(max_rel_error(ours[:, j], tight[:, j]) for j in range(len(KEYS)))
+    err_scipy = max(max_rel_error(ref[:, j], tight[:, j]) for j in range(len(KEYS)))
+    record(f"power-law batch, {n_batch:,} impacts (2 cores)", n_batch / batch, "loop of solve_ivp 1e-10",
+           scipy_rate, "impacts/s", f"max rel. err vs DOP853 1e-12: {err:.1e} (solve_ivp 1e-10: {err_scipy:.1e})")
+
+    family = np.full(n_batch, forces.POWER_LAW, dtype=np.int64)
+    params = np.column_stack([k, np.full(n_batch, 1.5), c])
+    clamp = np.ones(n_batch, dtype=np.bool_)
+    out = np.empty((n_batch, len(CHARACTERISTIC_COLUMNS)))
+    step = np.full(n_batch, 1e-4)
+    rk4_batch(family[:10], params[:10], clamp[:10], m[:10], v[:10], np.full(10, 0.03), step[:10], 10**6, out[:10])
+    rk4_time = best_of(lambda: rk4_batch(family, params, clamp, m, v, np.full(n_batch, 0.03), step, 10**6, out), 3)
+    rk4_err = max(max_rel_error(out[:n_ref, j], tight[:, i]) for i, j in enumerate(COL))
+    record(f"paper's RK4 1e-4 s batch, {n_batch:,} impacts", n_batch / rk4_time, "loop of solve_ivp 1e-10",
+           scipy_rate, "impacts/s", f"max rel. err (grid read-off): {rk4_err:.1e}")
+
+    # ------------------------------------------------------------------ CLI
+    exe = shutil.which("fruitimpact")
+    if exe:
+        subprocess.run([exe, "simulate"], capture_output=True, check=True)
+        cli = best_of(lambda: subprocess.run([exe, "simulate"], capture_output=True, check=True), 5)
+        py = best_of(lambda: subprocess.run([sys.executable, "-c", "pass"], capture_output=True, check=True), 5)
+        record("`fruitimpact simulate` wall time (warm cache)", cli, "bare `python -c pass`", py, "s",
+               "includes interpreter start")
+
+    if args.markdown:
+        with open(args.markdown, "w") as handle:
+            handle.write(f"Machine: {platform.processor() or platform.machine()}, {platform.python_version()}, "
+                         f"numpy {np.__version__}\n\n")
+            handle.write("| task | fruitimpact | unit | baseline | baseline value | ratio | note |\n|---|---|---|---|---|---|---|\n")
+            for task, ours_value, base, base_value, unit, ratio, note in rows:
+                handle.write(f"| {task} | {ours_value:.4g} | {unit} | {base} | {base_value:.4g} | {ratio:,.0f}× | {note} |\n")
+
+
+if __name__ == "__main__":
+    main()

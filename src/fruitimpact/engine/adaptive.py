@@ -1,0 +1,646 @@
+"""Adaptive Runge–Kutta integration of one impact, with exact event location.
+
+For the force laws of ``engine.forces`` that have no first integral (and for
+the power law too, as a cross-check of ``engine.powerlaw``):
+
+    m δ̈ = -F(δ, δ̇),   δ(0) = 0,   δ̇(0) = v0 > 0,
+
+in contact until separation.  Plain floats and arrays in, plain arrays out;
+no I/O, no unit conversion (SI throughout).
+
+Method
+------
+Dormand & Prince's explicit Runge–Kutta pair of order 8 with the 5th/3rd
+order error estimators and the 7th-order dense output (DOP853: Hairer,
+Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd ed.
+1993, §II.10; coefficients as in Hairer's ``dop853.f`` and SciPy's
+``solve_ivp``).  The local error is measured against the natural scales of
+the impact: rtol·δ_ref for δ (δ_ref the elastic part's undamped maximum
+deflection) and rtol·v0 for δ̇, so ``rtol`` is a relative accuracy of the
+characteristics.  Step-size control as in DOP853 (safety 0.9, factors
+0.2–10, no growth right after a rejection).
+
+The force laws with δ^0.5 or δ^0.25 factors make the right-hand side
+non-smooth at δ = 0 (first touch and, unclamped, separation); there the
+controller simply takes small steps (the local error of a step [t, t + h]
+near the singular point is O(t^q h^p), so the steps grow geometrically
+away from it: a few tens of extra stage evaluations per impact).
+
+Events are located on the dense output of the step in which they occur, by
+a bracketing (Illinois) root finder, never read off a grid:
+
+* separation: δ(t) = 0, or, clamped, the unclamped force F(t) = 0 while
+  δ̇ < 0, whichever comes first; the exit velocity is δ̇ there;
+* maximum deflection: δ̇(t) = 0;
+* peak force: dF/dt = ∂F/∂δ·δ̇ + ∂F/∂δ̇·δ̈ = 0 (analytic, with δ̈ = -F/m),
+  crossing from + to -; the force at first touch (b·v0 for Kelvin–Voigt)
+  is a candidate too;
+* peak Hertz pressure 3F/(2πRδ): d(F/δ)/dt = 0, crossing from + to -, and
+  the limits of F/δ at the ends of the contact.  Where a dissipative term
+  vanishes more slowly than δ at first touch (Kelvin–Voigt b > 0,
+  Kuwabara–Kono B > 0, Tsuji η > 0, power law n < 1) F/δ is unbounded and
+  the maximum pressure is +inf.
+
+Both event functions are evaluated as δ·dF/dt and δ²·d(F/δ)/dt, which are
+finite at δ = 0 for every family.
+
+Conventions follow ``engine.rk4``/``engine.powerlaw``: firmness_c is
+F_max/t_peak and firmness_c_star F_max/t_peak² (NaN when the peak force is
+at first touch), exit velocity positive.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .forces import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, contact_force
+from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
+
+_JIT = dict(cache=True, error_model="numpy")
+
+#: Default relative accuracy of the characteristics.
+DEFAULT_RTOL = 1e-10
+#: Accepted steps allowed per impact before giving up (return -1).
+MAX_STEPS = 100_000
+
+_SAFETY = 0.9
+_MIN_FACTOR = 0.2
+_MAX_FACTOR = 10.0
+
+# ---------------------------------------------------------------------------
+# DOP853 coefficients (Hairer's dop853.f; identical to SciPy's
+# scipy/integrate/_ivp/dop853_coefficients.py).  Stages 0–11 make the step,
+# stage 12 is f at the new point (FSAL), stages 13–15 serve the dense output.
+# ---------------------------------------------------------------------------
+_C = np.array([0.0, 0.05260015195876773, 0.0789002279381516, 0.1183503419072274,
+               0.2816496580927726, 0.3333333333333333, 0.25, 0.3076923076923077,
+               0.6512820512820513, 0.6, 0.8571428571428571, 1.0, 1.0, 0.1, 0.2,
+               0.7777777777777778])
+
+_A = np.zeros((16, 16))
+_A[1, 0] = 5.26001519587677318785587544488e-2
+_A[2, :2] = [1.97250569845378994544595329183e-2, 5.91751709536136983633785987549e-2]
+_A[3, [0, 2]] = [2.95875854768068491816892993775e-2, 8.87627564304205475450678981324e-2]
+_A[4, [0, 2, 3]] = [2.41365134159266685502369798665e-1, -8.84549479328286085344864962717e-1,
+                    9.24834003261792003115737966543e-1]
+_A[5, [0, 3, 4]] = [3.7037037037037037037037037037e-2, 1.70828608729473871279604482173e-1,
+                    1.25467687566822425016691814123e-1]
+_A[6, [0, 3, 4, 5]] = [3.7109375e-2, 1.70252211019544039314978060272e-1,
+                       6.02165389804559606850219397283e-2, -1.7578125e-2]
+_A[7, [0, 3, 4, 5, 6]] = [3.70920001185047927108779319836e-2, 1.70383925712239993810214054705e-1,
+                          1.07262030446373284651809199168e-1, -1.53194377486244017527936158236e-2,
+                          8.27378916381402288758473766002e-3]
+_A[8, [0, 3, 4, 5, 6, 7]] = [6.24110958716075717114429577812e-1, -3.36089262944694129406857109825,
+                             -8.68219346841726006818189891453e-1, 2.75920996994467083049415600797e1,
+                             2.01540675504778934086186788979e1, -4.34898841810699588477366255144e1]
+_A[9, [0, 3, 4, 5, 6, 7, 8]] = [4.77662536438264365890433908527e-1, -2.48811461997166764192642586468,
+                                -5.90290826836842996371446475743e-1, 2.12300514481811942347288949897e1,
+                                1.52792336328824235832596922938e1, -3.32882109689848629194453265587e1,
+                                -2.03312017085086261358222928593e-2]
+_A[10, [0, 3, 4, 5, 6, 7, 8, 9]] = [-9.3714243008598732571704021658e-1, 5.18637242884406370830023853209,
+                                    1.09143734899672957818500254654, -8.14978701074692612513997267357,
+                                    -1.85200656599969598641566180701e1, 2.27394870993505042818970056734e1,
+                                    2.49360555267965238987089396762, -3.0467644718982195003823669022]
+_A[11, [0, 3, 4, 5, 6, 7, 8, 9, 10]] = [2.27331014751653820792359768449, -1.05344954667372501984066689879e1,
+                                        -2.00087205822486249909675718444, -1.79589318631187989172765950534e1,
+                                        2.79488845294199600508499808837e1, -2.85899827713502369474065508674,
+                                        -8.87285693353062954433549289258, 1.23605671757943030647266201528e1,
+                                        6.43392746015763530355970484046e-1]
+_A[12, [0, 5, 6, 7, 8, 9, 10, 11]] = [5.42937341165687622380535766363e-2, 4.45031289275240888144113950566,
+                                      1.89151789931450038304281599044, -5.8012039600105847814672114227,
+                                      3.1116436695781989440891606237e-1, -1.52160949662516078556178806805e-1,
+                                      2.01365400804030348374776537501e-1, 4.47106157277725905176885569043e-2]
+_A[13, [0, 6, 7, 8, 9, 10, 11, 12]] = [5.61675022830479523392909219681e-2, 2.53500210216624811088794765333e-1,
+                                       -2.46239037470802489917441475441e-1, -1.24191423263816360469010140626e-1,
+                                       1.5329179827876569731206322685e-1, 8.20105229563468988491666602057e-3,
+                                       7.56789766054569976138603589584e-3, -8.298e-3]
+_A[14, [0, 5, 6, 7, 10, 11, 12, 13]] = [3.18346481635021405060768473261e-2, 2.83009096723667755288322961402e-2,
+                                        5.35419883074385676223797384372e-2, -5.49237485713909884646569340306e-2,
+                                        -1.08347328697249322858509316994e-4, 3.82571090835658412954920192323e-4,
+                                        -3.40465008687404560802977114492e-4, 1.41312443674632500278074618366e-1]
+_A[15, [0, 5, 6, 7, 8, 12, 13, 14]] = [-4.28896301583791923408573538692e-1, -4.69762141536116384314449447206,
+                                       7.68342119606259904184240953878, 4.06898981839711007970213554331,
+                                       3.56727187455281109270669543021e-1, -1.39902416515901462129418009734e-3,
+                                       2.9475147891527723389556272149, -9.15095847217987001081870187138]
+
+_B = _A[12, :12].copy()
+_E5 = np.array([0.01312004499419488, 0.0, 0.0, 0.0, 0.0, -1.2251564463762044, -0.4957589496572502,
+                1.6643771824549864, -0.35032884874997366, 0.3341791187130175, 0.08192320648511571,
+                -0.022355307863886294, 0.0])
+_E3 = np.array([-0.18980075407240762, 0.0, 0.0, 0.0, 0.0, 4.450312892752409, 1.8915178993145003,
+                -5.801203960010585, -0.4226823213237919, -0.1521609496625161, 0.20136540080403034,
+                0.02265179219836082, 0.0])
+_D = np.array([
+    [-8.428938276109013, 0.0, 0.0, 0.0, 0.0, 0.5667149535193777, -3.0689499459498917, 2.38466765651207,
+     2.117034582445028, -0.871391583777973, 2.2404374302607883, 0.6315787787694688, -0.08899033645133331,
+     18.148505520854727, -9.194632392478356, -4.436036387594894],
+    [10.427508642579134, 0.0, 0.0, 0.0, 0.0, 242.28349177525817, 165.20045171727028, -374.5467547226902,
+     -22.113666853125306, 7.733432668472264, -30.674084731089398, -9.332130526430229, 15.697238121770845,
+     -31.139403219565178, -9.35292435884448, 35.81684148639408],
+    [19.985053242002433, 0.0, 0.0, 0.0, 0.0, -387.0373087493518, -189.17813819516758, 527.8081592054236,
+     -11.57390253995963, 6.8812326946963, -1.0006050966910838, 0.7777137798053443, -2.778205752353508,
+     -60.19669523126412, 84.32040550667716, 11.99229113618279],
+    [-25.69393346270375, 0.0, 0.0, 0.0, 0.0, -154.18974869023643, -231.5293791760455, 357.6391179106141,
+     93.40532418362432, -37.45832313645163, 104.0996495089623, 29.8402934266605, -43.53345659001114,
+     96.32455395918828, -39.17726167561544, -149.72683625798564],
+])
+
+
+@nb.njit(**_JIT)
+def _deflection_scale(family, params, mass, velocity):
+    """δ_ref [m]: maximum deflection of the law's elastic part without
+    damping (energy balance ½ m v0² = ∫ F_el dδ); the error scale of δ."""
+    energy = 0.5 * mass * velocity * velocity
+    if family == POWER_LAW:
+        n = params[1]
+        scale = ((n + 1.0) * energy / params[0]) ** (1.0 / (n + 1.0))
+    elif family == KELVIN_VOIGT:
+        scale = math.sqrt(2.0 * energy / params[0])
+    else:  # Kuwabara–Kono and Tsuji: elastic part K δ^1.5
+        scale = (2.5 * energy / params[0]) ** 0.4
+    if not (scale > 0.0 and scale < math.inf):
+        scale = velocity * 1e-3  # no elastic part: any positive scale works
+    return scale
+
+
+@nb.njit(**_JIT)
+def _rates(family, params, clamp, inv_mass, d, v):
+    """(F, δ·dF/dt, δ²·d(F/δ)/dt) at the state (δ, δ̇), F the force that
+    drives the motion (clamped if ``clamp``).  dF/dt = F_δ δ̇ + F_δ̇ δ̈ with
+    δ̈ = -F/m; the factors δ and δ² keep both finite at δ = 0."""
+    force = contact_force(family, params, d, v, clamp)
+    if d < 0.0:
+        d = 0.0
+    if clamp and force <= 0.0:
+        return force, 0.0, 0.0
+    if family == POWER_LAW:
+        elastic = params[0] * d ** params[1]
+        d_fd = params[1] * force
+        d_fv = d * elastic * params[2]
+    elif family == KELVIN_VOIGT:
+        d_fd = params[0] * d
+        d_fv = params[1] * d
+    elif family == KUWABARA_KONO:
+        root = math.sqrt(d)
+        d_fd = params[0] * root * (1.5 * d + 0.5 * params[1] * v)
+        d_fv = params[0] * params[1] * d * root
+    else:  # TSUJI
+        quarter = math.sqrt(math.sqrt(d))
+        d_fd = 1.5 * params[0] * d * math.sqrt(d) + 0.25 * params[1] * quarter * v
+        d_fv = params[1] * d * quarter
+    g = d_fd * v - d_fv * force * inv_mass
+    return force, g, g - force * v
+
+
+@nb.njit(**_JIT)
+def _ratio_limit(family, params, clamp, rate):
+    """lim F/δ [N/m] as δ → 0+ at rate δ̇ (±inf where unbounded)."""
+    if family == POWER_LAW:
+        n = params[1]
+        factor = params[0] * (1.0 + params[2] * rate)
+        if n > 1.0:
+            limit = 0.0
+        elif n == 1.0:
+            limit = factor
+        else:
+            limit = math.inf * factor if factor != 0.0 else 0.0
+    elif family == KELVIN_VOIGT:
+        dash = params[1] * rate
+        limit = params[0] if dash == 0.0 else math.inf * dash
+    else:  # Kuwabara–Kono (K B δ^0.5 δ̇), Tsuji (η δ^0.25 δ̇)
+        dash = params[0] * params[1] * rate if family == KUWABARA_KONO else params[1] * rate
+        limit = 0.0 if dash == 0.0 else math.inf * dash
+    if clamp and limit < 0.0:
+        return 0.0
+    return limit
+
+
+@nb.njit(**_JIT)
+def _step(family, params, clamp, inv_mass, d, v, h, kd, kv):
+    """One DOP853 step from (δ, δ̇) with kd[0], kv[0] = f(δ, δ̇) set.
+    Fills stages 1–12 (12: f at the new point) and returns the new state."""
+    for s in range(1, 12):
+        sd = 0.0
+        sv = 0.0
+        for j in range(s):
+            a = _A[s, j]
+            sd += a * kd[j]
+            sv += a * kv[j]
+        vs = v + h * sv
+        kd[s] = vs
+        kv[s] = -contact_force(family, params, d + h * sd, vs, clamp) * inv_mass
+    sd = 0.0
+    sv = 0.0
+    for j in range(12):
+        sd += _B[j] * kd[j]
+        sv += _B[j] * kv[j]
+    d_new = d + h * sd
+    v_new = v + h * sv
+    kd[12] = v_new
+    kv[12] = -contact_force(family, params, d_new, v_new, clamp) * inv_mass
+    return d_new, v_new
+
+
+@nb.njit(**_JIT)
+def _error_norm(kd, kv, h, scale_d, scale_v):
+    """DOP853's combined 5th/3rd-order error estimate (≤ 1: accept)."""
+    e5d = 0.0
+    e5v = 0.0
+    e3d = 0.0
+    e3v = 0.0
+    for j in range(13):
+        e5d += _E5[j] * kd[j]
+        e5v += _E5[j] * kv[j]
+        e3d += _E3[j] * kd[j]
+        e3v += _E3[j] * kv[j]
+    e5d /= scale_d
+    e5v /= scale_v
+    e3d /= scale_d
+    e3v /= scale_v
+    err5 = e5d * e5d + e5v * e5v
+    err3 = e3d * e3d + e3v * e3v
+    if err5 == 0.0 and err3 == 0.0:
+        return 0.0
+    return abs(h) * err5 / math.sqrt((err5 + 0.01 * err3) * 2.0)
+
+
+@nb.njit(**_JIT)
+def _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv):
+    """Coefficients of DOP853's 7th-order interpolant on the last step
+    (three more stages)."""
+    for s in range(13, 16):
+        sd = 0.0
+        sv = 0.0
+        for j in range(s):
+            a = _A[s, j]
+            sd += a * kd[j]
+            sv += a * kv[j]
+        vs = v + h * sv
+        kd[s] = vs
+        kv[s] = -contact_force(family, params, d + h * sd, vs, clamp) * inv_mass
+    dd = d_new - d
+    dv = v_new - v
+    cd[0] = dd
+    cv[0] = dv
+    cd[1] = h * kd[0] - dd
+    cv[1] = h * kv[0] - dv
+    cd[2] = 2.0 * dd - h * (kd[12] + kd[0])
+    cv[2] = 2.0 * dv - h * (kv[12] + kv[0])
+    for i in range(4):
+        sd = 0.0
+        sv = 0.0
+        for j in range(16):
+            sd += _D[i, j] * kd[j]
+            sv += _D[i, j] * kv[j]
+        cd[3 + i] = h * sd
+        cv[3 + i] = h * sv
+
+
+@nb.njit(**_JIT)
+def _dense(theta, y0, coef):
+    """Interpolant at θ = (t - t_old)/h in [0, 1]."""
+    y = 0.0
+    for i in range(6, -1, -1):
+        y += coef[i]
+        if i % 2 == 0:
+            y *= theta
+        else:
+            y *= 1.0 - theta
+    return y0 + y
+
+
+@nb.njit(**_JIT)
+def _event(kind, theta, family, params, clamp, inv_mass, d0, v0, cd, cv):
+    """Event function on the interpolant: 0 δ, 1 δ̇, 2 δ·dF/dt,
+    3 δ²·d(F/δ)/dt, 4 unclamped F."""
+    d = _dense(theta, d0, cd)
+    if kind == 0:
+        return d
+    v = _dense(theta, v0, cv)
+    if kind == 1:
+        return v
+    if kind == 4:
+        return contact_force(family, params, d, v, False)
+    force, g, hp = _rates(family, params, clamp, inv_mass, d, v)
+    return g if kind == 2 else hp
+
+
+@nb.njit(**_JIT)
+def _root(kind, lo, f_lo, hi, f_hi, family, params, clamp, inv_mass, d0, v0, cd, cv):
+    """θ in [lo, hi] where event ``kind`` changes sign (f_lo, f_hi of
+    opposite signs or zero), by the Illinois variant of regula falsi,
+    to full double precision in θ."""
+    if f_lo == 0.0:
+        return lo
+    if f_hi == 0.0:
+        return hi
+    side = 0
+    theta = lo
+    for _ in range(100):
+        theta = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        if not (lo < theta < hi):
+            theta = 0.5 * (lo + hi)
+        f = _event(kind, theta, family, params, clamp, inv_mass, d0, v0, cd, cv)
+        if f == 0.0:
+            return theta
+        if (f > 0.0) == (f_hi > 0.0):
+            hi = theta
+            f_hi = f
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        else:
+            lo = theta
+            f_lo = f
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        if hi - lo <= 4e-16 * max(1.0, abs(hi)):
+            break
+    return theta
+
+
+@nb.njit(**_JIT)
+def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
+               times, curve_d, curve_v, curve_f):
+    """Integrate one impact; fill ``out`` (characteristics) and, at the
+    ascending ``times`` [s], the curves.  Returns the number of accepted
+    steps, or -1 (too many steps) / -2 (step size underflow)."""
+    inv_mass = 1.0 / mass
+    scale_d = rtol * _deflection_scale(family, params, mass, velocity)
+    scale_v = rtol * velocity
+    kd = np.empty(16)
+    kv = np.empty(16)
+    cd = np.empty(7)
+    cv = np.empty(7)
+
+    t = 0.0
+    d = 0.0
+    v = velocity
+    force0 = contact_force(family, params, 0.0, velocity, clamp)
+    kd[0] = v
+    kv[0] = -force0 * inv_mass
+
+    peak_force = force0
+    time_to_peak = 0.0
+    max_deflection = 0.0
+    time_to_max = 0.0
+    max_ratio = _ratio_limit(family, params, clamp, velocity)
+    # signs of dF/dt and d(F/δ)/dt just after first touch
+    if family == KELVIN_VOIGT:
+        g_old = params[0] * velocity - params[1] * force0 * inv_mass
+    else:
+        g_old = 1.0
+    h_old = 1.0 if max_ratio == 0.0 else -1.0
+
+    n_times = times.shape[0]
+    ti = 0
+    while ti < n_times and times[ti] <= 0.0:
+        curve_d[ti] = 0.0
+        curve_v[ti] = velocity
+        curve_f[ti] = force0
+        ti += 1
+
+    time_scale = scale_d / scale_v  # δ_ref / v0
+    h = 1e-3 * time_scale
+    rejected = False
+    steps = 0
+    while steps < MAX_STEPS:
+        d_new, v_new = _step(family, params, clamp, inv_mass, d, v, h, kd, kv)
+        err = _error_norm(kd, kv, h, scale_d, scale_v)
+        if not (err <= 1.0):  # also catches NaN
+            if err != err:
+                factor = _MIN_FACTOR
+            else:
+                factor = max(_MIN_FACTOR, _SAFETY * err ** -0.125)
+            h *= factor
+            rejected = True
+            if h <= 1e-14 * max(t, time_scale):
+                break
+            continue
+        steps += 1
+
+        # ---- events in the accepted step [t, t + h] ----
+        dense_ready = False
+        f_raw = contact_force(family, params, d_new, v_new, False)
+        ended = d_new <= 0.0 or (clamp and f_raw <= 0.0 and v_new < 0.0)
+        theta_end = 1.0
+        d_end = d_new
+        v_end = v_new
+        if ended:
+            _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+            dense_ready = True
+            touching = True  # separation where δ = 0 (else where the unclamped F = 0)
+            if d_new <= 0.0:
+                theta_end = _root(0, 0.0, d, 1.0, d_new, family, params, clamp, inv_mass, d, v, cd, cv)
+            if clamp and f_raw <= 0.0:
+                f_start = contact_force(family, params, d, v, False)
+                theta_f = _root(4, 0.0, f_start, 1.0, f_raw, family, params, clamp, inv_mass, d, v, cd, cv)
+                if theta_f < theta_end:
+                    theta_end = theta_f
+                    touching = False
+            d_end = 0.0 if touching else max(_dense(theta_end, d, cd), 0.0)
+            v_end = _dense(theta_end, v, cv)
+
+        if v > 0.0 and v_end <= 0.0:  # maximum deflection
+            if not dense_ready:
+                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                dense_ready = True
+            theta = _root(1, 0.0, v, theta_end, v_end, family, params, clamp, inv_mass, d, v, cd, cv)
+            max_deflection = _dense(theta, d, cd)
+            time_to_max = t + theta * h
+
+        force_end, g_end, h_end = _rates(family, params, clamp, inv_mass, d_end, v_end)
+        if g_old > 0.0 and g_end < 0.0:  # local maximum of F
+            if not dense_ready:
+                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                dense_ready = True
+            g_start = _event(2, 0.0, family, params, clamp, inv_mass, d, v, cd, cv)
+            theta = _root(2, 0.0, g_start, theta_end, g_end, family, params, clamp, inv_mass, d, v, cd, cv)
+            dd = _dense(theta, d, cd)
+            force = contact_force(family, params, dd, _dense(theta, v, cv), clamp)
+            if force > peak_force:
+                peak_force = force
+                time_to_peak = t + theta * h
+        if h_old > 0.0 and h_end < 0.0:  # local maximum of F/δ
+            if not dense_ready:
+                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                dense_ready = True
+            h_start = _event(3, 0.0, family, params, clamp, inv_mass, d, v, cd, cv)
+            theta = _root(3, 0.0, h_start, theta_end, h_end, family, params, clamp, inv_mass, d, v, cd, cv)
+            dd = _dense(theta, d, cd)
+            if dd > 0.0:
+                ratio = contact_force(family, params, dd, _dense(theta, v, cv), clamp) / dd
+                if ratio > max_ratio:
+                    max_ratio = ratio
+        if g_end != 0.0:
+            g_old = g_end
+        if h_end != 0.0:
+            h_old = h_end
+
+        t_end = t + theta_end * h
+        while ti < n_times and times[ti] < t_end:
+            if not dense_ready:
+                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                dense_ready = True
+            theta = (times[ti] - t) / h
+            dd = _dense(theta, d, cd)
+            vv = _dense(theta, v, cv)
+            curve_d[ti] = max(dd, 0.0)
+            curve_v[ti] = vv
+            curve_f[ti] = contact_force(family, params, dd, vv, clamp)
+            ti += 1
+
+        if ended:
+            while ti < n_times:
+                curve_d[ti] = d_end
+                curve_v[ti] = v_end
+                curve_f[ti] = 0.0
+                ti += 1
+            if d_end > 0.0:
+                ratio = force_end / d_end
+            else:
+                ratio = _ratio_limit(family, params, clamp, v_end)
+            if ratio > max_ratio:
+                max_ratio = ratio
+            out[0] = peak_force
+            out[1] = time_to_peak
+            out[2] = t_end
+            out[3] = max_deflection
+            out[4] = time_to_max
+            out[5] = -v_end
+            out[6] = -v_end / velocity
+            out[7] = 0.5 * mass * (velocity * velocity - v_end * v_end)
+            out[8] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
+            out[9] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
+            out[10] = 3.0 * max_ratio / (2.0 * math.pi * radius)
+            out[11] = math.sqrt(radius * max_deflection)
+            return steps
+
+        # ---- advance ----
+        t += h
+        d = d_new
+        v = v_new
+        kd[0] = kd[12]
+        kv[0] = kv[12]
+        factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, _SAFETY * err ** -0.125)
+        if rejected:
+            factor = min(1.0, factor)
+            rejected = False
+        h *= factor
+
+    for j in range(out.shape[0]):
+        out[j] = math.nan
+    for j in range(ti, n_times):
+        curve_d[j] = math.nan
+        curve_v[j] = math.nan
+        curve_f[j] = math.nan
+    return -1 if steps >= MAX_STEPS else -2
+
+
+@nb.njit(**_JIT)
+def adaptive_impact(family, params, clamp, mass, velocity, radius, rtol, out):
+    """Characteristics of one impact m δ̈ = -F(δ, δ̇) by adaptive DOP853.
+
+    Parameters: ``family`` and ``params`` as in ``engine.forces``; ``clamp``
+    keeps F ≥ 0 and ends contact where the unclamped force vanishes during
+    restitution; mass m [kg]; impact velocity v0 > 0 [m/s]; radius R [m]
+    (contact radius sqrt(R δ_max), Hertz pressure 3F/(2πRδ)); rtol [-], the
+    relative accuracy asked of the characteristics (1e-10 is a good value).
+
+    Fills ``out`` (length ≥ 12) in the order of ``CHARACTERISTIC_COLUMNS``.
+    Returns the number of accepted steps (> 0), or a negative number (and
+    NaNs in ``out``) if the integration failed."""
+    none = out[:0]  # no curve samples (an empty, writable view: no allocation)
+    return _integrate(family, params, clamp, mass, velocity, radius, rtol, out, none, none, none, none)
+
+
+@nb.njit(parallel=True, **_JIT)
+def adaptive_batch(family, params, clamp, mass, velocity, radius, rtol, out):
+    """Characteristics of many impacts: row i uses family[i], params[i, :],
+    clamp[i], mass[i], velocity[i], radius[i] and fills out[i, :]."""
+    for i in nb.prange(mass.shape[0]):
+        adaptive_impact(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], rtol, out[i])
+
+
+@nb.njit(**_JIT)
+def _curves_kernel(family, params, clamp, mass, velocity, rtol, times, deflection, rate, force, out):
+    return _integrate(family, params, clamp, mass, velocity, 1.0, rtol, out, times, deflection, rate, force)
+
+
+def adaptive_characteristics(family, params, clamp, mass, velocity, radius,
+                             rtol: float = DEFAULT_RTOL) -> np.ndarray:
+    """Characteristics of impacts under any force law of ``engine.forces``.
+
+    Parameters
+    ----------
+    family : int or array_like of int
+        Force family code (``engine.forces.POWER_LAW`` …).
+    params : array_like, shape (P,) or (..., P)
+        Force parameters, one row per impact or one row for all.
+    clamp : bool or array_like of bool
+        Keep F ≥ 0 (contact ends when the unclamped force vanishes).
+    mass, velocity, radius : array_like
+        m [kg], v0 > 0 [m/s], effective radius R [m].
+    rtol : float
+        Relative accuracy of the characteristics.
+
+    Returns
+    -------
+    ndarray, shape (rows, len(CHARACTERISTIC_COLUMNS))
+        Inputs broadcast together (params along its leading axes) and
+        flattened to rows.  Rows whose integration failed are NaN.
+        Inputs are not validated here: validate at the boundary.
+    """
+    params = np.asarray(params, dtype=float)
+    if params.ndim == 0:
+        params = params.reshape(1)
+    scalars = [np.asarray(family, dtype=np.int64), np.asarray(clamp, dtype=np.bool_),
+               np.asarray(mass, dtype=float), np.asarray(velocity, dtype=float),
+               np.asarray(radius, dtype=float)]
+    shape = np.broadcast_shapes(params.shape[:-1], *(a.shape for a in scalars))
+    scalars = [np.ascontiguousarray(np.broadcast_to(a, shape).ravel()) for a in scalars]
+    n_params = max(params.shape[-1], 3)
+    rows = scalars[0].shape[0]
+    table = np.zeros((rows, n_params))
+    table[:, :params.shape[-1]] = np.broadcast_to(params, shape + params.shape[-1:]).reshape(rows, -1)
+    out = np.empty((rows, N_CHARACTERISTICS))
+    adaptive_batch(scalars[0], table, scalars[1], scalars[2], scalars[3], scalars[4], float(rtol), out)
+    return out
+
+
+def adaptive_curves(family: int, params, clamp: bool, mass: float, velocity: float, times,
+                    rtol: float = DEFAULT_RTOL):
+    """Deflection δ [m], rate δ̇ [m/s] and force F [N] at ``times`` [s] for one
+    impact, from the dense output of the adaptive integration.  Times ≤ 0 give
+    the state at first touch; times at or after the end of contact give the
+    separation state (δ_end, δ̇_exit) with F = 0.
+
+    Returns (deflection, rate, force, contact_duration)."""
+    times = np.asarray(times, dtype=float)
+    flat = times.ravel()
+    order = np.argsort(flat, kind="stable")
+    sorted_times = np.ascontiguousarray(flat[order])
+    d = np.empty_like(sorted_times)
+    v = np.empty_like(sorted_times)
+    f = np.empty_like(sorted_times)
+    table = np.zeros(max(np.size(params), 3))
+    table[:np.size(params)] = np.asarray(params, dtype=float).ravel()
+    out = np.empty(N_CHARACTERISTICS)
+    _curves_kernel(int(family), table, bool(clamp), float(mass), float(velocity), float(rtol),
+                   sorted_times, d, v, f, out)
+    deflection = np.empty_like(d)
+    rate = np.empty_like(v)
+    force = np.empty_like(f)
+    deflection[order] = d
+    rate[order] = v
+    force[order] = f
+    return (deflection.reshape(times.shape), rate.reshape(times.shape), force.reshape(times.shape),
+            float(out[2]))
+
+
+__all__ = ["adaptive_impact", "adaptive_batch", "adaptive_characteristics", "adaptive_curves",
+           "CHARACTERISTIC_COLUMNS", "N_CHARACTERISTICS", "DEFAULT_RTOL"]

@@ -1,0 +1,139 @@
+"""The library refuses the same bad inputs as the CLI, with the same words.
+
+``fruitimpact.Fruit(...)`` and ``fruitimpact.simulate(...)`` raise ``ValueError``
+whose message is exactly the CLI's stderr line after its
+``fruitimpact simulate: error: argument --x: `` prefix.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+import fruitimpact
+from fruitimpact.cli import main
+
+FRUIT_FIELDS = ("mass", "diameter", "modulus", "poisson", "stiffness")
+
+# (library keyword, CLI value, SI float the library gets)
+CASES = []
+for _name in ("mass", "diameter", "modulus", "stiffness", "velocity", "drop_height", "step"):
+    for _text in ("0", "-1", "nan", "inf", "-inf"):
+        CASES.append((_name, _text, float(_text)))
+for _text in ("-1", "0.5", "-1.5", "0.7", "nan", "inf"):
+    CASES.append(("poisson", _text, float(_text)))
+for _text in ("0", "-0.1", "1.0001", "nan", "2"):
+    CASES.append(("restitution", _text, float(_text)))
+for _text in ("1", "2", "-0.1", "nan"):
+    CASES.append(("alpha", _text, float(_text)))
+CASES += [
+    ("model", "foo", "foo"),
+    ("calibration", "approx", "approx"),
+    ("method", "euler", "euler"),
+    ("mass", "1e400", math.inf),
+]
+
+
+def _library_error(name, value) -> str:
+    with pytest.raises(ValueError) as info:
+        if name in FRUIT_FIELDS:
+            fruitimpact.Fruit(**{name: value})
+        else:
+            fruitimpact.simulate(**{name: value})
+    return str(info.value)
+
+
+def _cli_error(capsys, name, text) -> str:
+    option = "--" + name.replace("_", "-")
+    status = main(["simulate", f"{option}={text}"])
+    out, err = capsys.readouterr()
+    assert status == 2 and out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    prefix = f"fruitimpact simulate: error: argument {option}: "
+    assert lines[0].startswith(prefix), lines[0]
+    return lines[0][len(prefix):]
+
+
+@pytest.mark.parametrize("name, text, value", CASES, ids=[f"{n}={t}" for n, t, _ in CASES])
+def test_library_message_equals_cli_message(capsys, name, text, value):
+    message = _library_error(name, value)
+    assert "\n" not in message
+    assert message.startswith(name + " ")  # names the argument
+    assert message == _cli_error(capsys, name, text)
+
+
+@pytest.mark.parametrize("name, value, allowed", [
+    ("mass", 0.0, "> 0 kg"),
+    ("diameter", -0.065, "> 0 m"),
+    ("modulus", math.nan, "> 0 Pa"),
+    ("stiffness", math.inf, "> 0 N/m^1.5"),
+    ("poisson", 0.5, "(-1, 0.5)"),
+    ("poisson", -1.0, "(-1, 0.5)"),
+])
+def test_fruit_rejects_out_of_range(name, value, allowed):
+    with pytest.raises(ValueError, match=rf"^{name} must be ") as info:
+        fruitimpact.Fruit(**{name: value})
+    assert allowed in str(info.value)
+    assert f"got {value!r}" in str(info.value)
+
+
+@pytest.mark.parametrize("kwargs, allowed", [
+    (dict(velocity=0.0), "velocity must be a finite number > 0 m/s"),
+    (dict(drop_height=-0.3), "drop_height must be a finite number > 0 m"),
+    (dict(step=math.nan), "step must be a finite number > 0 s"),
+    (dict(restitution=1.0001), "restitution must be in (0, 1]"),
+    (dict(restitution=0.0), "restitution must be in (0, 1]"),
+    (dict(alpha=0.5, velocity=2.0), "alpha must be in "),
+    (dict(alpha=1.0), "alpha must be in "),
+    (dict(model="foo"), "model must be one of hertz, hunt-crossley, chen"),
+    (dict(calibration="foo"), "calibration must be one of paper, exact"),
+    (dict(method="foo"), "method must be one of accurate, rk4"),
+])
+def test_simulate_rejects_out_of_range(kwargs, allowed):
+    with pytest.raises(ValueError) as info:
+        fruitimpact.simulate(**kwargs)
+    assert str(info.value).startswith(allowed), str(info.value)
+    if "alpha" in kwargs:  # the bound 1/V_i and the reason are stated
+        assert f", {1 / kwargs.get('velocity', 1.0):g})" in str(info.value)
+        assert "1 - alpha*V_i" in str(info.value)
+
+
+@pytest.mark.parametrize("kwargs, first, second", [
+    (dict(velocity=1.0, drop_height=0.3), "velocity", "drop_height"),
+    (dict(restitution=0.5, alpha=0.1), "restitution", "alpha"),
+])
+def test_simulate_rejects_conflicts(capsys, kwargs, first, second):
+    with pytest.raises(ValueError) as info:
+        fruitimpact.simulate(**kwargs)
+    message = str(info.value)
+    assert message == f"give either {first} or {second}, not both"
+    # the CLI says the same with the options as typed
+    argv = ["simulate"]
+    for key, value in kwargs.items():
+        argv += ["--" + key.replace("_", "-"), str(value)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    cli = f"give either --{first.replace('_', '-')} or --{second.replace('_', '-')}, not both"
+    assert err == f"fruitimpact simulate: error: {cli}\n"
+
+
+@pytest.mark.parametrize("name", ["mass", "diameter", "modulus", "poisson", "stiffness"])
+def test_fruit_rejects_non_numbers(name):
+    with pytest.raises(ValueError, match=rf"^{name} must be a number; got 'abc'$"):
+        fruitimpact.Fruit(**{name: "abc"})
+
+
+@pytest.mark.parametrize("name", ["velocity", "drop_height", "restitution", "alpha", "step"])
+def test_simulate_rejects_non_numbers(name):
+    with pytest.raises(ValueError, match=rf"^{name} must be a number; got 'abc'$"):
+        fruitimpact.simulate(**{name: "abc"})
+
+
+def test_valid_library_call_matches_cli_defaults():
+    result = fruitimpact.simulate(fruitimpact.Fruit(mass=0.115, diameter=0.065, modulus=3e6, poisson=0.37),
+                                  velocity=1.0, restitution=0.577)
+    assert result.success
+    assert result.characteristics.restitution == pytest.approx(0.577, abs=1e-8)
+    assert fruitimpact.simulate().to_dict()["peak_force"] == result.characteristics.peak_force
