@@ -484,11 +484,9 @@ def test_script_bad_input(argv, option):
     assert lines[0].startswith(PREFIX) and option in lines[0]
 
 
-# --------------------------------------------------------------------------- known bug (see report)
-@pytest.mark.xfail(strict=True, reason="rk4 with a step longer than the contact reports success with "
-                                       "F_max = 0, T = 0, e = -1 (solvers._rk4_characteristics)")
-def test_rk4_step_longer_than_contact_is_not_a_silent_success(capsys):
+# --------------------------------------------------------------------------- coarse RK4 step
+def test_rk4_step_longer_than_contact_is_refused(capsys):
+    # a step that leaves fewer than 20 steps per contact is bad input, not a silent success
     status, out, err = run(capsys, "--method", "rk4", "--step", "10ms", "--json")
-    if status == 0:
-        r = json.loads(out)
-        assert r["success"] is False or (r["peak_force"] > 0 and 0 < r["restitution"] <= 1)
+    assert status == 2 and out == ""
+    assert err.count("\n") == 1 and "--step" in err and "at least 20 steps" in err

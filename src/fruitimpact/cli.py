@@ -138,7 +138,7 @@ def format_result_table(result) -> str:
         f"E = {fruit.modulus / 1e6:.4g} MPa, ν = {fruit.poisson:.4g}",
         f"impact     V_i = {inputs.velocity:.4g} m/s"
         + (f" (drop {inputs.drop_height * 100:.4g} cm)" if inputs.drop_height is not None else "")
-        + f", target k = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else "",
+        + (f", target k = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else ""),
         f"law        {inputs.model}, calibration {inputs.calibration}, method {inputs.method}"
         + (f" (step {inputs.step:g} s)" if inputs.method == "rk4" else ""),
         f"contact    k_c = {result.law.stiffness / 1e6:.5g}e6 N/m^1.5, λ = {result.law.damping / 1e6:.5g}e6 N·s/m^2.5"
@@ -269,7 +269,8 @@ def main(argv=None) -> int:
             return 2
         return args.func(args)
     except UsageError as exc:
-        command = getattr(locals().get("args"), "command", None)
+        command = getattr(locals().get("args"), "command", None) or next(
+            (token for token in argv if token in ("simulate", "paper")), None)
         prefix = f"{PROG} {command}" if command else PROG
         print(f"{prefix}: error: {exc}", file=sys.stderr)
         return 2

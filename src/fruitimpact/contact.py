@@ -67,6 +67,7 @@ def hertz_max_deflection(mass, stiffness, velocity, exponent=1.5):
 
 def hertz_contact_duration(mass, stiffness, velocity):
     """Contact duration of an undamped Hertz impact (n = 3/2) [s]:
-    T = 2 B(1/2, 2/5) · (4/5) δ_max / v0 = 2.9432 δ_max/v0 (Johnson 1985, eq 11.25)."""
+    T = (4/5) B(1/2, 2/5) δ_max/v0 = 2.9432 δ_max/v0, B the Euler beta function
+    (Johnson 1985, §11.4; from integrating the energy equation)."""
     beta = math.gamma(0.5) * math.gamma(0.4) / math.gamma(0.9)
     return 0.8 * beta * hertz_max_deflection(mass, stiffness, velocity) / np.asarray(velocity, dtype=float)

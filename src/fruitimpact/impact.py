@@ -299,6 +299,12 @@ def prepare(fruit: Fruit | None = None, *, velocity=None, drop_height=None, rest
         restitution = check_range("restitution", restitution, 0.0, 1.0, high_inclusive=True)
         target = restitution
     stiffness, radius = resolve_stiffness(fruit, surface)
+    if method == "rk4":
+        # at least 20 steps per contact: the undamped Hertz duration is a lower bound of T
+        # for the laws here (damping lengthens the contact)
+        longest = float(contact.hertz_contact_duration(fruit.mass, stiffness, velocity)) / 20.0
+        step = check_range("step", step, 0.0, longest, high_inclusive=True,
+                           unit="s for this impact (at least 20 steps per contact)")
     damping_factor = cal.damping_factor(law, target, velocity)
     inputs = ImpactInputs(fruit=fruit, surface=surface, velocity=velocity, drop_height=drop_height,
                           restitution=restitution, alpha=alpha, model=law.name, calibration=cal.name,

@@ -34,11 +34,11 @@ SI_UNIT = {
     "frequency": "Hz", "dimensionless": "",
 }
 
-_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf(?:inity)?|nan)\s*(.*?)\s*$",
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf(?:inity)?|[-+]?nan)\s*(.*?)\s*$",
                      re.IGNORECASE)
 
 
-def parse_quantity(text: str | float, dimension: str, name: str = "value") -> float:
+def parse_quantity(text: str | float, dimension: str) -> float:
     """Parse ``text`` (``"115g"``, ``"3 MPa"``, ``"0.065"``) to a float in SI.
 
     Parameters
@@ -47,8 +47,6 @@ def parse_quantity(text: str | float, dimension: str, name: str = "value") -> fl
         A number, optionally followed by a unit of ``dimension``.
     dimension : str
         A key of ``UNITS``.
-    name : str
-        Argument name for the error message.
 
     Raises
     ------
@@ -64,7 +62,6 @@ def parse_quantity(text: str | float, dimension: str, name: str = "value") -> fl
         raise ValueError(f"cannot read {text!r} as a number with a unit "
                          f"(units allowed: {allowed}; a plain number is {SI_UNIT[dimension] or 'dimensionless'})")
     number, unit = match.groups()
-    unit = unit.replace(" ", "")
     if unit == "":
         return float(number)
     if unit not in units:
