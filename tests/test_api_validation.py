@@ -87,7 +87,7 @@ def test_fruit_rejects_out_of_range(name, value, allowed):
     (dict(restitution=0.0), "restitution must be in (0, 1]"),
     (dict(alpha=0.5, velocity=2.0), "alpha must be in "),
     (dict(alpha=1.0), "alpha must be in "),
-    (dict(model="foo"), "model must be one of hertz, hunt-crossley, chen"),
+    (dict(model="foo"), "model must be one of hertz, hunt-crossley, herbert-mcwhannell"),
     (dict(calibration="foo"), "calibration must be one of paper, exact"),
     (dict(method="foo"), "method must be one of accurate, rk4"),
 ])

@@ -19,6 +19,8 @@ from functools import cached_property
 import numpy as np
 
 from . import contact
+from .calibrate import damping_factor as calibrated_damping_factor
+from .calibrate import law_params
 from .constants import (JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY,
                         STANDARD_GRAVITY)
 from .engine import forces
@@ -97,20 +99,22 @@ RIGID_PLANE = Surface()
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """The resolved force law F = K δ^n (1 + c δ̇) of one impact.
+    """The resolved force law of one impact.
 
     Attributes
     ----------
     stiffness : float
-        k_c = K [N/m^1.5].
+        The elastic coefficient: k_c = K [N/m^1.5] for the Hertz-type laws, the
+        linear k [N/m] for Kelvin–Voigt.
     damping_factor : float
-        c = λ/k_c [s/m].
+        damping/stiffness: c = λ/k_c [s/m] for F = K δ^n (1 + c δ̇); b/k [s] for
+        Kelvin–Voigt; B [s] for Kuwabara–Kono; η/K [s·m^0.25] for Tsuji.
     exponent : float
-        n [-] (3/2, Hertz).
+        n [-] of the power-law family (3/2, Hertz).
     family : int
         Force family code of ``engine.forces``.
     clamp : bool
-        Whether the force is kept non-negative.
+        Whether the fruit separates as soon as the force would become tensile.
     """
 
     stiffness: float
@@ -121,12 +125,13 @@ class ContactLaw:
 
     @property
     def damping(self) -> float:
-        """λ = c·k_c [N·s/m^2.5] (the paper's λ1, A or β)."""
+        """Coefficient of the rate term: λ [N·s/m^2.5] (F_d = λ δ^1.5 δ̇; the paper's
+        λ1, A or β), b [N·s/m] (Kelvin–Voigt), K·B (Kuwabara–Kono), η (Tsuji)."""
         return self.damping_factor * self.stiffness
 
     def params(self) -> np.ndarray:
         """Parameter vector for the compiled force of ``family``."""
-        return np.array([self.stiffness, self.exponent, self.damping_factor])
+        return law_params(self.family, self.stiffness, self.damping_factor, self.exponent)
 
 
 @dataclass(frozen=True)
@@ -305,11 +310,13 @@ def prepare(fruit: Fruit | None = None, *, velocity=None, drop_height=None, rest
         longest = float(contact.hertz_contact_duration(fruit.mass, stiffness, velocity)) / 20.0
         step = check_range("step", step, 0.0, longest, high_inclusive=True,
                            unit="s for this impact (at least 20 steps per contact)")
-    damping_factor = cal.damping_factor(law, target, velocity)
+    factor = float(calibrated_damping_factor(law, cal.name, target, fruit.mass, stiffness, velocity))
     inputs = ImpactInputs(fruit=fruit, surface=surface, velocity=velocity, drop_height=drop_height,
                           restitution=restitution, alpha=alpha, model=law.name, calibration=cal.name,
                           method=method, step=step)
-    return inputs, ContactLaw(stiffness=stiffness, damping_factor=damping_factor), radius
+    force_law = ContactLaw(stiffness=float(law.linear_stiffness(fruit.mass, stiffness, velocity)),
+                           damping_factor=factor, family=law.family, clamp=law.clamp)
+    return inputs, force_law, radius
 
 
 def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, restitution=None,

@@ -1,29 +1,64 @@
 """Registry of contact damping laws and of calibrations.
 
-A *damping law* says how the damping of the contact follows from a
-restitution coefficient e.  For the power-law family used by the paper,
-F = K δ^(3/2) (1 + c δ̇) (eqs 11, 14, 23; λ = c·K is the paper's λ1 or β),
-each published law is a closed form χ(e) = c·v0.  A *calibration* says
-which e → c rule is applied: the law's own published formula (``paper``) or
-the exact inverse of the achieved restitution (``exact``), which makes the
-simulated restitution equal the requested one for every law of the family.
+A *damping law* says which force law the contact follows and how its damping
+follows from a restitution coefficient e.  Most published laws belong to the
+power-law family used by the paper, F = K δ^(3/2) (1 + c δ̇) (eqs 11, 14, 23;
+λ = c·K is the paper's λ1 or β), and differ only in the closed form
+χ(e) = c·v0 their authors derived.  Others are different force families:
+the linear Kelvin–Voigt spring–dashpot, the viscoelastic-sphere law of
+Kuwabara & Kono / Brilliantov, and the Tsuji law used by DEM codes.
 
-Add a law by adding a ``DampingLaw`` to ``DAMPING_LAWS``; nothing else needs
-to change.
+A *calibration* says which e → damping rule is applied: the law's own
+published formula (``paper``), or the exact inverse of the restitution the
+law really produces (``exact``), which makes the simulated restitution equal
+the requested one.
+
+Formulas were checked against the sources and public implementations listed
+in docs/models.md; the achieved-restitution tables there are produced by
+``fruitimpact models`` and verified by an independent integration in
+tests/test_models.py.  Add a law by adding a ``DampingLaw`` to
+``DAMPING_LAWS``; nothing else needs to change.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+
+import numpy as np
 
 from .engine import forces
-from .engine.powerlaw import x_of_restitution
+from .engine.powerlaw import exact_x
+
+#: First-order coefficient of the Kuwabara–Kono restitution, e = 1 - C1 b + ...,
+#: b = B (K/m)^(2/5) v0^(1/5):  C1 = Γ(3/5) √π / (2^(1/5) 5^(2/5) Γ(21/10)) = 1.153449
+#: (Schwager & Pöschel, Phys. Rev. E 78 (2008) 051304; Ramírez et al., Phys. Rev. E 60 (1999) 4465).
+KUWABARA_KONO_C1 = math.gamma(0.6) * math.sqrt(math.pi) / (2 ** 0.2 * 5 ** 0.4 * math.gamma(2.1))
+
+#: Undamped Hertz contact duration T = HERTZ_DURATION_FACTOR · δ_H / v0 = (4/5) B(1/2, 2/5) δ_H/v0.
+HERTZ_DURATION_FACTOR = 0.8 * math.gamma(0.5) * math.gamma(0.4) / math.gamma(0.9)
+
+
+def _log_decrement_ratio(e):
+    """ζ = -ln e / sqrt(π² + ln² e): damping ratio of a linear oscillator whose
+    half-period decay is e (exact for the unclamped linear law)."""
+    log_e = np.log(e)
+    return -log_e / np.sqrt(np.pi ** 2 + log_e ** 2)
+
+
+def hertz_equivalent_linear_stiffness(mass, stiffness, velocity):
+    """k [N/m] of the linear spring whose undamped contact duration π sqrt(m/k)
+    equals the Hertz one at this impact, 2.943 δ_H/v0 (the usual way DEM codes
+    match a linear law to a Hertz contact)."""
+    delta_h = (1.25 * mass * velocity ** 2 / stiffness) ** 0.4
+    duration = HERTZ_DURATION_FACTOR * delta_h / velocity
+    return mass * (math.pi / duration) ** 2
 
 
 @dataclass(frozen=True)
 class DampingLaw:
-    """A published damping law of the power-law family F = K δ^n (1 + c δ̇).
+    """A published contact damping law.
 
     Attributes
     ----------
@@ -32,93 +67,238 @@ class DampingLaw:
     title : str
         Authors and year.
     source : str
-        Full citation of the formula.
-    chi : callable or None
-        χ(e) = c·v0 [-] as published; None for the undamped Hertz law.
+        Full citation of the formula, and where its transcription was checked.
     validity : str
         The range of e for which the source derived or recommends it.
+    family : int
+        Force family (``engine.forces``): POWER_LAW, KELVIN_VOIGT, KUWABARA_KONO or TSUJI.
+    clamp : bool
+        Whether the fruit separates as soon as the force would become tensile.
+    chi : callable or None
+        Power-law family only: χ(e) = c·v0 [-] as published; None means λ = 0.
+    published : callable or None
+        Other families: (e, m, K, v0) → damping factor as published (see ``ContactLaw``).
+    group : callable or None
+        Other families: (damping factor, m, K, v0) → the dimensionless damping group on
+        which alone the restitution depends; with ``from_group`` its inverse.
+    from_group : callable or None
     note : str
-        What else a user should know (aliases, transcription issues).
+        What else a user should know (aliases, unconfirmed transcriptions).
     """
 
     name: str
     title: str
     source: str
-    chi: Callable[[float], float] | None
     validity: str
+    family: int = forces.POWER_LAW
+    clamp: bool = True
+    chi: Callable | None = None
+    published: Callable | None = None
+    group: Callable | None = None
+    from_group: Callable | None = None
     note: str = ""
-    family: int = field(default=forces.POWER_LAW, repr=False)
+    #: the published calibration already gives the requested e exactly
+    exact_by_construction: bool = False
 
-    def published_damping_factor(self, restitution: float, velocity: float) -> float:
-        """c = χ(e)/v0 [s/m] by the law's own formula."""
-        if self.chi is None:
-            return 0.0
-        return self.chi(restitution) / velocity
+    @property
+    def undamped(self) -> bool:
+        return self.family == forces.POWER_LAW and self.chi is None and not self.exact_by_construction
+
+    def linear_stiffness(self, mass, stiffness, velocity):
+        """The stiffness the law's force uses: K for the Hertz-type laws, the
+        Hertz-equivalent linear k for Kelvin–Voigt."""
+        if self.family == forces.KELVIN_VOIGT:
+            return hertz_equivalent_linear_stiffness(mass, stiffness, velocity)
+        return stiffness
+
+    def published_damping_factor(self, restitution, mass, stiffness, velocity):
+        """Damping factor (see ``ContactLaw``) by the law's own formula."""
+        if self.family == forces.POWER_LAW:
+            if self.exact_by_construction:
+                return exact_x(restitution) / velocity
+            return 0.0 if self.chi is None else self.chi(restitution) / velocity
+        return self.published(restitution, mass, stiffness, velocity)
+
+
+def _kv_published(e, m, k_hertz, v):
+    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
+    zeta = _log_decrement_ratio(e)
+    return 2.0 * zeta * np.sqrt(k * m) / k  # b/k [s]
+
+
+def _kv_group(factor, m, k_hertz, v):
+    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
+    return factor * k / (2.0 * np.sqrt(k * m))  # ζ
+
+
+def _kv_from_group(zeta, m, k_hertz, v):
+    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
+    return 2.0 * zeta * np.sqrt(k * m) / k
+
+
+def _kk_published(e, m, k, v):
+    return (1.0 - e) / (KUWABARA_KONO_C1 * (k / m) ** 0.4 * v ** 0.2)  # B [s]
+
+
+def _kk_group(factor, m, k, v):
+    return factor * (k / m) ** 0.4 * v ** 0.2  # b
+
+
+def _kk_from_group(b, m, k, v):
+    return b / ((k / m) ** 0.4 * v ** 0.2)
+
+
+def _tsuji_alpha(e):
+    log_e = np.log(e)
+    return -np.sqrt(5.0) * log_e / np.sqrt(log_e ** 2 + np.pi ** 2)
+
+
+def _tsuji_published(e, m, k, v):
+    return _tsuji_alpha(e) * np.sqrt(m * k) / k  # η/K
+
+
+def _tsuji_group(factor, m, k, v):
+    return factor * k / np.sqrt(m * k)  # α
+
+
+def _tsuji_from_group(alpha, m, k, v):
+    return alpha * np.sqrt(m * k) / k
+
+
+_MACHADO = ("transcription as in Machado et al., Mech. Mach. Theory 53 (2012) 99-121, and in the public DyS code "
+            "that follows it; the original was not available to check")
+
+DAMPING_LAWS: dict[str, DampingLaw] = {}
+
+
+def register(law: DampingLaw, *aliases: str) -> DampingLaw:
+    """Add ``law`` to ``DAMPING_LAWS`` under its name and any aliases."""
+    for key in (law.name, *aliases):
+        DAMPING_LAWS[key] = law
+    return law
+
+
+register(DampingLaw(
+    name="hertz", title="Hertz (undamped)",
+    source="H. Hertz, J. reine angew. Math. 92 (1882) 156-171; apple paper eqs 7-9.",
+    validity="e = 1 (elastic impact)", note="λ = 0; any restitution given is ignored."))
+register(DampingLaw(
+    name="hunt-crossley", title="Hunt & Crossley 1975",
+    source=("K. H. Hunt, F. R. E. Crossley, Coefficient of restitution interpreted as damping in vibroimpact, "
+            "J. Appl. Mech. 42 (1975) 440-445; apple paper eqs 5, 6, 11: λ = (3/2) α k_c with e = 1 - α v0 "
+            "(as in Simbody's HuntCrossleyForce and Marhefka & Orin 1999)."),
+    chi=lambda e: 1.5 * (1.0 - e),
+    validity="first order in (1 - e): e close to 1; gives e too high below 0.9"))
+register(DampingLaw(
+    name="herbert-mcwhannell", title="Herbert & McWhannell 1977",
+    source=("R. G. Herbert, D. C. McWhannell, Shape and frequency composition of pulses from an impact pair, "
+            "J. Eng. Ind. 99 (1977) 513-518; χ = 6(1-e)/((2e-1)² + 3); " + _MACHADO + "."),
+    chi=lambda e: 6.0 * (1.0 - e) / ((2.0 * e - 1.0) ** 2 + 3.0),
+    validity="tends to Hunt-Crossley as e → 1; χ stays finite at e = 0, so achieved e never falls below 0.49"))
+register(DampingLaw(
+    name="lee-wang", title="Lee & Wang 1983",
+    source=("T. W. Lee, A. C. Wang, On the dynamics of intermittent-motion mechanisms, part 1, J. Mech. Transm. "
+            "Autom. Des. 105 (1983) 534-540; χ = 3(1-e)/4; " + _MACHADO + "."),
+    chi=lambda e: 0.75 * (1.0 - e),
+    validity="half the Hunt-Crossley damping even as e → 1 (achieved 1-e ≈ (1-target)/2): inconsistent with this "
+             "force law; kept for comparison only"))
+register(DampingLaw(
+    name="chen", title="Lankarani & Nikravesh 1990 (the paper's 'Chen')",
+    source=("H. M. Lankarani, P. E. Nikravesh, A contact force model with hysteresis damping for impact analysis "
+            "of multibody systems, J. Mech. Des. 112 (1990) 369-376; apple paper eqs 21, 23 (attributed there to "
+            "Chen & De Baerdemaeker 1995): λ = β = (3/4) k_c (1 - e²)/v0."),
+    chi=lambda e: 0.75 * (1.0 - e * e),
+    validity="first order in (1 - e), from the energy lost along the undamped path: e close to 1",
+    note="The paper calls it 'Chen'; it is the Lankarani–Nikravesh form. Alias: lankarani-nikravesh."),
+    "lankarani-nikravesh")
+register(DampingLaw(
+    name="gonthier", title="Gonthier, McPhee, Lange & Piedbœuf 2004",
+    source=("Y. Gonthier, J. McPhee, C. Lange, J.-C. Piedbœuf, A regularized contact model with asymmetric damping "
+            "and dwell-time dependent friction, Multibody Syst. Dyn. 11 (2004) 209-233; χ = (1 - e²)/e "
+            "(confirmed in two public implementations)."),
+    chi=lambda e: (1.0 - e * e) / e,
+    validity="all e in (0, 1]; over-damps slightly near e = 1 (target 0.9 gives 0.876)"))
+register(DampingLaw(
+    name="zhiying-qishao", title="Zhiying & Qishao 2006",
+    source=("Q. Zhiying, L. Qishao, Analysis of impact process based on restitution coefficient, J. Dyn. Control "
+            "4 (2006) 294-298; χ = 3(1 - e²) exp(2(1 - e))/4; " + _MACHADO + "."),
+    chi=lambda e: 0.75 * (1.0 - e * e) * np.exp(2.0 * (1.0 - e)),
+    validity="good for e ≈ 0.4-0.9; χ finite at e = 0, so achieved e never falls below 0.18"))
+register(DampingLaw(
+    name="flores", title="Flores, Machado, Silva & Martins 2011",
+    source=("P. Flores, M. Machado, M. T. Silva, J. M. Martins, On the continuous contact force models for soft "
+            "materials in multibody dynamics, Multibody Syst. Dyn. 25 (2011) 357-375; χ = 8(1 - e)/(5e) "
+            "(confirmed in the OpenSees documentation and three public implementations)."),
+    chi=lambda e: 1.6 * (1.0 - e) / e,
+    validity="derived for soft materials over the whole range of e; over-damps slightly (target 0.5 gives 0.470)"))
+register(DampingLaw(
+    name="hu-guo", title="Hu & Guo 2015",
+    source=("S. Hu, X. Guo, A dissipative contact force model for impact analysis in multibody dynamics, "
+            "Multibody Syst. Dyn. 35 (2015) 131-151; χ = 3(1 - e)/(2e)."),
+    chi=lambda e: 1.5 * (1.0 - e) / e,
+    validity="all e in (0, 1]",
+    note="UNCONFIRMED transcription: the only public implementation found uses 3(1 - e)/(4e)."))
+register(DampingLaw(
+    name="gharib-hurmuzlu", title="Gharib & Hurmuzlu 2012",
+    source=("M. Gharib, Y. Hurmuzlu, A new contact force model for low coefficient of restitution impact, "
+            "J. Appl. Mech. 79 (2012) 064506; χ = (1 - e)/e."),
+    chi=lambda e: (1.0 - e) / e,
+    validity="meant for low e (matches the exact e → 1/χ limit); under-damps near e = 1",
+    note="UNCONFIRMED transcription: no public source of the formula could be found."))
+register(DampingLaw(
+    name="exact", title="Exact inverse of the Hunt-Crossley first integral",
+    source=("this package: χ solves (1 + χ) = (1 - e χ) exp((1 + e) χ), the exact restitution of "
+            "F = K δ^n (1 + c δ̇) (first integral of Hunt & Crossley 1975; docs/physics.md)."),
+    validity="all e in (0, 1]: the simulated restitution equals e", exact_by_construction=True))
+for _clamp in (False, True):
+    _suffix = "-clamped" if _clamp else ""
+    register(DampingLaw(
+        name="kelvin-voigt" + _suffix,
+        title="Kelvin-Voigt linear spring-dashpot" + (" (force clamped at 0)" if _clamp else ""),
+        source=("linear spring-dashpot F = k δ + b δ̇ with ζ = b/(2 sqrt(k m)) = -ln e/sqrt(π² + ln² e), exact for "
+                "the unclamped law; clamped, the fruit separates when F = 0 (T. Schwager, T. Pöschel, Coefficient "
+                "of restitution and linear-dashpot model revisited, Granular Matter 9 (2007) 465-469). k is the "
+                "linear stiffness with the Hertz contact duration at this impact."),
+        validity=("exact for every e when unclamped (but the force is b·v0 at first touch and tensile before "
+                  "separation)" if not _clamp else
+                  "the published ζ(e) assumes no clamp: clamped, the achieved e is higher (target 0.5 gives 0.55)"),
+        family=forces.KELVIN_VOIGT, clamp=_clamp, published=_kv_published, group=_kv_group,
+        from_group=_kv_from_group, exact_by_construction=not _clamp))
+    register(DampingLaw(
+        name="tsuji" + _suffix,
+        title="Tsuji, Tanaka & Ishida 1992" + (" (force clamped at 0)" if _clamp else ""),
+        source=("Y. Tsuji, T. Tanaka, T. Ishida, Lagrangian numerical simulation of plug flow of cohesionless "
+                "particles in a horizontal pipe, Powder Technol. 71 (1992) 239-250: F = K δ^1.5 + α sqrt(m K) "
+                "δ^(1/4) δ̇ with α = -sqrt(5) ln e/sqrt(ln² e + π²), the form of YADE, Chrono DEM-Engine and MUSEN."),
+        validity=("exact for every e and velocity when unclamped (δ^(5/4) makes it a linear oscillator)"
+                  if not _clamp else "clamped at F ≥ 0 the achieved e is higher: target 0.2 gives 0.325, 0.5 gives "
+                                     "0.550, for any mass, stiffness and velocity"),
+        family=forces.TSUJI, clamp=_clamp, published=_tsuji_published, group=_tsuji_group,
+        from_group=_tsuji_from_group, exact_by_construction=not _clamp))
+    register(DampingLaw(
+        name="kuwabara-kono" + ("" if _clamp else "-unclamped"),
+        title="Kuwabara & Kono 1987 / Brilliantov et al. 1996" + ("" if _clamp else " (force may go tensile)"),
+        source=("G. Kuwabara, K. Kono, Jpn. J. Appl. Phys. 26 (1987) 1230; N. V. Brilliantov et al., Model for "
+                "collisions in granular gases, Phys. Rev. E 53 (1996) 5382-5392: F = K (δ^1.5 + B δ^0.5 δ̇), "
+                "B calibrated by the first-order restitution e = 1 - 1.153449 B (K/m)^(2/5) v0^(1/5) "
+                "(Schwager & Pöschel, Phys. Rev. E 78 (2008) 051304)."),
+        validity="first order in b = B (K/m)^(2/5) v0^(1/5): b ≲ 0.1 (e ≳ 0.9); far off at apple-like e ≈ 0.5",
+        family=forces.KUWABARA_KONO, clamp=_clamp, published=_kk_published, group=_kk_group,
+        from_group=_kk_from_group,
+        note="" if _clamp else "Without the clamp the force turns tensile before δ returns to 0."))
 
 
 @dataclass(frozen=True)
 class Calibration:
-    """A rule turning a restitution coefficient into the damping factor c."""
+    """A rule turning a restitution coefficient into the law's damping."""
 
     name: str
     description: str
-    rule: Callable[[DampingLaw, float, float], float] = field(repr=False)
 
-    def damping_factor(self, law: DampingLaw, restitution: float, velocity: float) -> float:
-        """c [s/m] for ``law`` at restitution e and impact velocity v0 [m/s]."""
-        if law.chi is None:  # undamped Hertz: nothing to calibrate
-            return 0.0
-        return self.rule(law, restitution, velocity)
-
-
-def exact_damping_factor(restitution: float, velocity: float) -> float:
-    """c [s/m] such that F = K δ^n (1 + c δ̇) rebounds with exactly e
-    (root of (1 + x) = (1 - e x) exp((1 + e) x), x = c v0; docs/physics.md)."""
-    return x_of_restitution(float(restitution)) / velocity
-
-
-DAMPING_LAWS: dict[str, DampingLaw] = {
-    "hertz": DampingLaw(
-        name="hertz",
-        title="Hertz (undamped)",
-        source="H. Hertz, J. reine angew. Math. 92 (1882) 156-171; apple paper eq 7-9.",
-        chi=None,
-        validity="e = 1 (elastic impact)",
-        note="λ = 0; any restitution given is ignored.",
-    ),
-    "hunt-crossley": DampingLaw(
-        name="hunt-crossley",
-        title="Hunt & Crossley 1975",
-        source=("K. H. Hunt, F. R. E. Crossley, Coefficient of restitution interpreted as damping in "
-                "vibroimpact, J. Appl. Mech. 42 (1975) 440-445; apple paper eqs 5, 6, 11: "
-                "λ = (3/2) α k_c with e = 1 - α v0."),
-        chi=lambda e: 1.5 * (1.0 - e),
-        validity="first order in (1 - e): e close to 1; gives e too high for e < 0.9",
-    ),
-    "chen": DampingLaw(
-        name="chen",
-        title="Lankarani & Nikravesh 1990 (the paper's 'Chen')",
-        source=("H. M. Lankarani, P. E. Nikravesh, A contact force model with hysteresis damping for impact "
-                "analysis of multibody systems, J. Mech. Des. 112 (1990) 369-376; apple paper eqs 21, 23 "
-                "(attributed there to Chen & De Baerdemaeker 1995): λ = β = (3/4) k_c (1 - e²)/v0."),
-        chi=lambda e: 0.75 * (1.0 - e * e),
-        validity="first order in (1 - e): e close to 1",
-        note="The paper calls it 'Chen'; it is the Lankarani–Nikravesh form. Alias: lankarani-nikravesh.",
-    ),
-}
-DAMPING_LAWS["lankarani-nikravesh"] = DAMPING_LAWS["chen"]
 
 CALIBRATIONS: dict[str, Calibration] = {
-    "paper": Calibration(
-        name="paper",
-        description="the law's published formula (for hunt-crossley α = (1-k)/V_i, eq 6; for chen eq 21)",
-        rule=lambda law, e, v: law.published_damping_factor(e, v),
-    ),
-    "exact": Calibration(
-        name="exact",
-        description="λ chosen so that the simulated restitution equals the requested one exactly",
-        rule=lambda law, e, v: exact_damping_factor(e, v),
-    ),
+    "paper": Calibration("paper", "the law's published formula (for hunt-crossley α = (1-k)/V_i, eq 6; for chen eq 21)"),
+    "exact": Calibration("exact", "damping chosen so that the simulated restitution equals the requested one exactly"),
 }
 
 

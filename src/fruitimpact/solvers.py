@@ -37,20 +37,34 @@ def closed_forms(law, mass: float, velocity: float) -> tuple[float, float]:
     return max_deflection, restitution_of_x(x)
 
 
+#: Relative tolerance of the compiled adaptive integrator (laws without a first integral).
+ADAPTIVE_RTOL = 1e-10
+
+
 def _accurate_characteristics(law, mass, velocity, radius, step):
-    if law.family != forces.POWER_LAW:
-        raise NotImplementedError("accurate solver: only the power-law family in this version")
-    values = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, radius)
+    if law.family == forces.POWER_LAW:
+        values = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, radius)
+    else:
+        from .engine.adaptive import adaptive_impact
+
+        values = np.empty(N_CHARACTERISTICS)
+        if adaptive_impact(law.family, law.params(), law.clamp, mass, velocity, radius, ADAPTIVE_RTOL, values) < 0:
+            return tuple(float(v) for v in values), False, "adaptive integrator did not reach separation"
     if not np.all(np.isfinite(values[:10])):
         return tuple(values), False, "accurate solver produced non-finite characteristics"
     return tuple(float(v) for v in values), True, "ok"
 
 
 def _accurate_curves(law, mass, velocity, step, points):
-    duration = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, 1.0)[2]
-    times = np.linspace(0.0, duration, int(points))
-    deflection, rate, force, _ = powerlaw_curves(mass, law.stiffness, law.damping_factor, velocity,
-                                                 times, law.exponent)
+    values, _, _ = _accurate_characteristics(law, mass, velocity, 1.0, step)
+    times = np.linspace(0.0, values[2], int(points))
+    if law.family == forces.POWER_LAW:
+        deflection, rate, force, _ = powerlaw_curves(mass, law.stiffness, law.damping_factor, velocity,
+                                                     times, law.exponent)
+    else:
+        from .engine.adaptive import adaptive_curves
+
+        deflection, rate, force, _ = adaptive_curves(law.family, law.params(), law.clamp, mass, velocity, times)
     return times, deflection, rate, force
 
 
