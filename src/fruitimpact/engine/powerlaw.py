@@ -112,8 +112,10 @@ def separation_zeta(x, r_x):
         zeta_new = zeta + step
         if zeta_new > 0.0:
             zeta_new = 0.5 * zeta
-        if abs(zeta_new - zeta) <= 4e-16 * abs(zeta_new):
-            return zeta_new
+        # quadratic convergence: once a step is below 1e-8 the next error is below 1e-16
+        if abs(zeta_new - zeta) <= 1e-8 * abs(zeta_new):
+            w = zeta_new * e1_func(x * zeta_new)
+            return zeta_new + delta_phi(x, zeta_new, r_x) / w
         zeta = zeta_new
     return zeta
 
@@ -136,8 +138,11 @@ def stationary_zeta(x, n, r_x, zeta1, order):
         zeta_new = zeta - h / dh
         if zeta_new < 0.0:
             zeta_new = 0.5 * zeta
-        if abs(zeta_new - zeta) <= 4e-16 * zeta1:
-            return zeta_new
+        if abs(zeta_new - zeta) <= 1e-8 * zeta1:  # one more (quadratic) step reaches rounding
+            exz = math.exp(x * zeta_new)
+            w = zeta_new * e1_func(x * zeta_new)
+            h = x * (n + 1.0) * delta_phi(x, zeta_new, r_x) - order * w
+            return zeta_new - h / (-x * (n + 1.0) * w - order * exz)
         zeta = zeta_new
     return zeta
 
