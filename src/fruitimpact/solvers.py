@@ -50,9 +50,23 @@ def _accurate_characteristics(law, mass, velocity, radius, step):
         values = np.empty(N_CHARACTERISTICS)
         if adaptive_impact(law.family, law.params(), law.clamp, mass, velocity, radius, ADAPTIVE_RTOL, values) < 0:
             return tuple(float(v) for v in values), False, "adaptive integrator did not reach separation"
-    if not np.all(np.isfinite(values[:10])):
-        return tuple(values), False, "accurate solver produced non-finite characteristics"
-    return tuple(float(v) for v in values), True, "ok"
+    return _judge(values)
+
+
+#: Characteristics that every completed impact has (peak force, duration, δ_max, e).
+_ESSENTIAL = [0, 2, 3, 6]
+
+
+def _judge(values):
+    """(values, success, message): success needs the essential characteristics
+    finite; a peak at first touch (a dashpot's force jump) leaves C and C*
+    undefined, which is reported, not failed."""
+    values = tuple(float(v) for v in values)
+    if not all(np.isfinite(values[i]) for i in _ESSENTIAL):
+        return values, False, "solver produced non-finite characteristics"
+    if values[1] == 0.0:
+        return values, True, "peak force at first touch (force jump of the dashpot): C and C* undefined"
+    return values, True, "ok"
 
 
 def _accurate_curves(law, mass, velocity, step, points):
@@ -87,7 +101,7 @@ def _rk4_characteristics(law, mass, velocity, radius, step):
     count, _, out = _rk4_run(law, mass, velocity, radius, step, False)
     if count < 0:
         return tuple(out), False, f"rk4: contact did not end within {RK4_MAX_STEPS} steps of {step:g} s"
-    return tuple(float(v) for v in out), True, "ok"
+    return _judge(out)
 
 
 def _rk4_curves(law, mass, velocity, step, points):
