@@ -218,6 +218,49 @@ def cmd_paper(args) -> int:
     return 0
 
 
+def _float_list(option: str, text: str, low: float, high: float, high_inclusive: bool) -> list[float]:
+    """"0.3,0.5,0.7" → floats, each in (low, high) or (low, high]."""
+    values = []
+    for item in text.split(","):
+        try:
+            value = float(parse_quantity(item, "velocity" if option == "--velocities" else "dimensionless"))
+        except ValueError as exc:
+            raise UsageError(f"argument {option}: {exc}") from None
+        if not (math.isfinite(value) and low < value and (value <= high if high_inclusive else value < high)):
+            bracket = "]" if high_inclusive else ")"
+            raise UsageError(f"argument {option}: each value must be in ({low:g}, {high:g}{bracket}; got {item!r}")
+        values.append(value)
+    return values
+
+
+def cmd_models(args) -> int:
+    from .comparison import format_restitution_table, restitution_figure, restitution_table
+    from .models import DAMPING_LAWS
+
+    for name in args.model or ():
+        if name not in DAMPING_LAWS:
+            raise UsageError(f"argument --model: model must be one of {', '.join(DAMPING_LAWS)}; got {name!r}")
+    targets = _float_list("--targets", args.targets, 0.0, 1.0, True)
+    velocities = _float_list("--velocities", args.velocities, 0.0, math.inf, False)
+    table = restitution_table(args.model, targets, velocities)
+    if args.csv:
+        table.to_csv(args.csv, index=False)
+    if args.plot:
+        from .plotting import save_figure
+
+        save_figure(restitution_figure(table), args.plot)
+    if args.json:
+        print(dump_json(table.to_dict(orient="records")))
+    else:
+        print("Restitution each law's published calibration really produces (Jonathan apple: M = 115 g, "
+              "k_c = 0.835e6 N/m^1.5)\n")
+        print(format_restitution_table(table))
+        for what, path in (("table", args.csv), ("figure", args.plot)):
+            if path:
+                print(f"{what} written to {path}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -236,6 +279,19 @@ def build_parser() -> argparse.ArgumentParser:
     pap.add_argument("--json", action="store_true", help="print everything as JSON")
     pap.add_argument("--figures", metavar="DIR", help="write the worked example's figures to DIR")
     pap.set_defaults(func=cmd_paper)
+
+    mod = sub.add_parser("models", help="achieved vs requested restitution of every damping law",
+                         description="For each damping law, the restitution its published calibration really "
+                                     "produces against the one it was given.")
+    mod.add_argument("--model", action="append", metavar="NAME", help="only this law (repeatable)")
+    mod.add_argument("--targets", default="0.1,0.3,0.5,0.7,0.9", metavar="LIST",
+                     help="requested restitution coefficients, comma-separated, each in (0, 1]")
+    mod.add_argument("--velocities", default="0.5,1,3", metavar="LIST",
+                     help="impact velocities, comma-separated, each > 0 [m/s]")
+    mod.add_argument("--json", action="store_true", help="print the table as JSON records")
+    mod.add_argument("--csv", metavar="FILE", help="write the table as CSV")
+    mod.add_argument("--plot", metavar="FILE", help="write achieved vs requested e (PNG/SVG/PDF)")
+    mod.set_defaults(func=cmd_models)
     return parser
 
 
@@ -290,7 +346,7 @@ def main(argv=None) -> int:
         return args.func(args)
     except UsageError as exc:
         command = getattr(locals().get("args"), "command", None) or next(
-            (token for token in argv if token in ("simulate", "paper")), None)
+            (token for token in argv if token in ("simulate", "paper", "models")), None)
         prefix = f"{PROG} {command}" if command else PROG
         print(f"{prefix}: error: {exc}", file=sys.stderr)
         return 2
