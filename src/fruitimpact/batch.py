@@ -41,7 +41,9 @@ INPUT_COLUMNS = {
 }
 TEXT_COLUMNS = {"model": "hunt-crossley", "calibration": "exact", "method": "accurate"}
 LAW_COLUMNS = ("stiffness", "damping", "damping_factor")
-OUTPUT_COLUMNS = (tuple(INPUT_COLUMNS) + tuple(TEXT_COLUMNS) + ("target_restitution",)
+# the requested restitution is reported as target_restitution (k, or 1 - α V_i), since
+# "restitution" is the achieved one
+OUTPUT_COLUMNS = (tuple(c for c in INPUT_COLUMNS if c != "restitution") + tuple(TEXT_COLUMNS) + ("target_restitution",)
                   + ("law_stiffness", "damping", "damping_factor") + CHARACTERISTIC_COLUMNS + ("status", "message"))
 
 
@@ -178,7 +180,7 @@ def evaluate(frame) -> "pandas.DataFrame":  # noqa: F821
     messages[computed] = "solver did not reach separation (non-finite characteristics)"
     messages[status == "ok"] = "ok"
 
-    data = {name: values[name] for name in INPUT_COLUMNS}
+    data = {name: values[name] for name in INPUT_COLUMNS if name != "restitution"}
     data["velocity"] = velocity
     data["stiffness"] = stiffness
     data.update(text)
@@ -191,3 +193,36 @@ def evaluate(frame) -> "pandas.DataFrame":  # noqa: F821
     data["status"] = status
     data["message"] = messages
     return pd.DataFrame(data, columns=list(OUTPUT_COLUMNS))
+
+
+def curves(frame, times=None, points: int = 201):
+    """Curves of every valid row of ``frame``: a dict with ``row`` (the row numbers),
+    ``time`` [s], ``deflection`` [m], ``rate`` [m/s] and ``force`` [N], each of shape
+    (rows, points).  ``times`` [s] is a common grid (points,) or one grid per row
+    (rows, points); by default each row gets ``points`` samples over its own [0, T]."""
+    results = evaluate(frame)
+    rows = np.flatnonzero(results["status"].to_numpy() == "ok")
+    ok = results.iloc[rows]
+    if times is None:
+        grid = np.linspace(0.0, 1.0, int(points))[None, :] * ok["contact_duration"].to_numpy()[:, None]
+    else:
+        grid = np.broadcast_to(np.asarray(times, dtype=float), (len(rows), np.shape(times)[-1])).copy()
+    shape = grid.shape
+    deflection, rate, force = np.empty(shape), np.empty(shape), np.empty(shape)
+    for model, group in ok.groupby("model", sort=False):
+        law = DAMPING_LAWS[model]
+        idx = np.flatnonzero(ok["model"].to_numpy() == model)
+        m, v = group["mass"].to_numpy(), group["velocity"].to_numpy()
+        k, c = group["law_stiffness"].to_numpy(), group["damping_factor"].to_numpy()
+        if law.family == forces.POWER_LAW:
+            from .engine.powerlaw import powerlaw_curves_batch
+
+            deflection[idx], rate[idx], force[idx] = powerlaw_curves_batch(m, k, c, v, grid[idx])
+        else:
+            from .engine.adaptive import adaptive_curves
+
+            params = law_params(law.family, k, c)
+            for j, i in enumerate(idx):
+                deflection[i], rate[i], force[i], _ = adaptive_curves(law.family, params[j], law.clamp, m[j], v[j],
+                                                                      grid[i])
+    return dict(row=rows, time=grid, deflection=deflection, rate=rate, force=force)

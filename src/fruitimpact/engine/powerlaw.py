@@ -589,3 +589,27 @@ def _tabulated_kernel(mass, stiffness, n, damping_factor, velocity, radius, coef
     for i in nb.prange(mass.shape[0]):
         _tabulated_row(mass[i], stiffness[i], n, damping_factor[i], velocity[i], radius[i], coefficients, width,
                        x_max, up_nodes, up_weights, lo_nodes, lo_weights, out[i])
+
+
+@nb.njit(parallel=True, **_JIT)
+def _curves_batch_kernel(mass, stiffness, n, damping_factor, velocity, times,
+                         up_nodes, up_weights, lo_nodes, lo_weights, deflection, rate, force):
+    for i in nb.prange(mass.shape[0]):
+        _curves_kernel(mass[i], stiffness[i], n, damping_factor[i], velocity[i], times[i],
+                       up_nodes, up_weights, lo_nodes, lo_weights, deflection[i], rate[i], force[i])
+
+
+def powerlaw_curves_batch(mass, stiffness, damping_factor, velocity, times, exponent: float = 1.5):
+    """δ [m], δ̇ [m/s], F [N] of many impacts at ``times`` [s]: shape (points,) for a
+    common grid or (rows, points) for one grid per row.  Returns three (rows, points)
+    arrays from the exact phase curve (as ``powerlaw_curves``, row by row)."""
+    mass, stiffness, damping_factor, velocity = (np.ascontiguousarray(np.atleast_1d(np.asarray(a, dtype=float)))
+                                                 for a in np.broadcast_arrays(mass, stiffness, damping_factor, velocity))
+    times = np.asarray(times, dtype=float)
+    times = np.ascontiguousarray(np.broadcast_to(times, (mass.shape[0], times.shape[-1])))
+    deflection = np.empty_like(times)
+    rate = np.empty_like(times)
+    force = np.empty_like(times)
+    _curves_batch_kernel(mass, stiffness, float(exponent), damping_factor, velocity, times, *_rules(float(exponent)),
+                         deflection, rate, force)
+    return deflection, rate, force
