@@ -289,7 +289,7 @@ def powerlaw_characteristics(mass, stiffness, damping_factor, velocity, radius,
         _tabulated_kernel(arrays[0], arrays[1], float(exponent), arrays[2], arrays[3], arrays[4], coefficients,
                           width, TABLE_X_MAX, *_rules(float(exponent)), out)
         return out
-    kernel = _characteristics_kernel if (parallel if parallel is not None else rows > 2000) \
+    kernel = _characteristics_kernel if (parallel if parallel is not None else rows > PARALLEL_MIN_ROWS) \
         else _characteristics_kernel_serial
     kernel(arrays[0], arrays[1], float(exponent), arrays[2], arrays[3], arrays[4],
            *_rules(float(exponent)), out)
@@ -438,17 +438,34 @@ def _vector_x_of_restitution(e, out):
         out[i] = x_of_restitution(e[i])
 
 
+@nb.njit(**_JIT)
+def _vector_x_of_restitution_serial(e, out):
+    for i in range(e.shape[0]):
+        out[i] = x_of_restitution(e[i])
+
+
 @nb.njit(parallel=True, **_JIT)
 def _vector_restitution_of_x(x, out):
     for i in nb.prange(x.shape[0]):
         out[i] = restitution_of_x(x[i])
 
 
+@nb.njit(**_JIT)
+def _vector_restitution_of_x_serial(x, out):
+    for i in range(x.shape[0]):
+        out[i] = restitution_of_x(x[i])
+
+
+#: Below this many rows the serial kernels win: starting threads costs more
+#: than the work, and far more when the other cores are busy.
+PARALLEL_MIN_ROWS = 2000
+
+
 def exact_x(restitution):
     """Vectorised ``x_of_restitution``: x = c·v0 from e ∈ (0, 1]."""
     e = np.ascontiguousarray(np.atleast_1d(np.asarray(restitution, dtype=float)).ravel())
     out = np.empty_like(e)
-    _vector_x_of_restitution(e, out)
+    (_vector_x_of_restitution if e.shape[0] > PARALLEL_MIN_ROWS else _vector_x_of_restitution_serial)(e, out)
     return out.reshape(np.shape(restitution))
 
 
@@ -456,7 +473,7 @@ def exact_restitution(x):
     """Vectorised ``restitution_of_x``: e from x = c·v0 ≥ 0."""
     xs = np.ascontiguousarray(np.atleast_1d(np.asarray(x, dtype=float)).ravel())
     out = np.empty_like(xs)
-    _vector_restitution_of_x(xs, out)
+    (_vector_restitution_of_x if xs.shape[0] > PARALLEL_MIN_ROWS else _vector_restitution_of_x_serial)(xs, out)
     return out.reshape(np.shape(x))
 
 
