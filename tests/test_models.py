@@ -94,9 +94,12 @@ def test_achieved_restitution_agrees_with_independent_integration(table, name):
 @pytest.mark.parametrize("name", [law.name for law in unique_laws() if law.name != "hertz"])
 @pytest.mark.parametrize("target", [0.2, 0.5, 0.8])
 def test_exact_calibration_hits_target_for_every_law(name, target):
+    # power-law family: closed-form inverse, to rounding (1e-12); other families: the
+    # inverse is as good as the adaptive integrator's e (rtol 1e-10), so 1e-8
     result = simulate(APPLE, velocity=1.3, restitution=target, model=name, calibration="exact")
     assert result.success
-    assert result.characteristics.restitution == pytest.approx(target, rel=1e-9)
+    tolerance = 1e-12 if DAMPING_LAWS[name].family == forces.POWER_LAW else 1e-8
+    assert result.characteristics.restitution == pytest.approx(target, rel=tolerance)
 
 
 @pytest.mark.parametrize("e", [0.1, 0.5, 0.9])
