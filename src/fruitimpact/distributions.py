@@ -1,0 +1,251 @@
+"""Distributions of impact inputs for Monte Carlo populations.
+
+A spec string names a distribution and its parameters, each parameter a number
+with an optional unit of the input's dimension (``fruitimpact.units``)::
+
+    0.115 | 115g                      constant
+    normal(mean, sd)                  normal (Gaussian)
+    lognormal(median, sigma)          log-normal: ln X ~ N(ln median, sigma²);
+                                      median in the input's unit, sigma dimensionless
+                                      (the sd of ln X, e.g. 0.1 ≈ 10 % spread)
+    uniform(lo, hi)                   uniform on [lo, hi)
+    truncnormal(mean, sd, lo, hi)     normal truncated to [lo, hi] (rejection sampling)
+    sample(FILE[:COLUMN])             bootstrap (draw with replacement) from a measured
+                                      sample: a CSV or Parquet column, cells may carry units
+
+``parse_distribution(text, dimension)`` returns a frozen dataclass with
+``draw(rng, size) -> ndarray`` [SI] and ``identity()`` (a JSON-able description
+used to recognise a job).  Bad specs raise ``ValueError`` with one line.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .units import parse_quantity
+
+_CALL = re.compile(r"^\s*([A-Za-z_][A-Za-z_0-9]*)\s*\((.*)\)\s*$", re.DOTALL)
+#: Below this probability of [lo, hi] under the untruncated normal, truncnormal is refused.
+TRUNCNORMAL_MIN_MASS = 1e-3
+
+
+@dataclass(frozen=True)
+class Constant:
+    """Every member has the same value [SI]."""
+
+    value: float
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        return np.full(size, self.value)
+
+    def identity(self) -> dict:
+        return {"constant": self.value}
+
+    def describe(self) -> str:
+        return f"{self.value:.6g}"
+
+
+@dataclass(frozen=True)
+class Normal:
+    """Normal distribution: ``mean`` and standard deviation ``sd`` [SI]."""
+
+    mean: float
+    sd: float
+    signature = "normal(mean, sd)"
+
+    def __post_init__(self):
+        if not (math.isfinite(self.mean) and math.isfinite(self.sd) and self.sd >= 0):
+            raise ValueError("normal(mean, sd) needs finite values and sd >= 0")
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        return rng.normal(self.mean, self.sd, size)
+
+    def identity(self) -> dict:
+        return {"normal": [self.mean, self.sd]}
+
+    def describe(self) -> str:
+        return f"normal(mean={self.mean:.6g}, sd={self.sd:.6g})"
+
+
+@dataclass(frozen=True)
+class LogNormal:
+    """Log-normal distribution: ln X ~ N(ln ``median``, ``sigma``²).
+
+    ``median`` [SI] is the median of X (= exp of the mean of ln X); ``sigma``
+    [-] is the standard deviation of ln X."""
+
+    median: float
+    sigma: float
+    signature = "lognormal(median, sigma)"
+    dimensionless = (1,)  # sigma has no unit
+
+    def __post_init__(self):
+        if not (math.isfinite(self.median) and self.median > 0 and math.isfinite(self.sigma) and self.sigma >= 0):
+            raise ValueError("lognormal(median, sigma) needs median > 0 and sigma >= 0 "
+                             "(sigma is the sd of ln X, dimensionless)")
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        return self.median * np.exp(rng.normal(0.0, self.sigma, size))
+
+    def identity(self) -> dict:
+        return {"lognormal": [self.median, self.sigma]}
+
+    def describe(self) -> str:
+        return f"lognormal(median={self.median:.6g}, sigma={self.sigma:.6g})"
+
+
+@dataclass(frozen=True)
+class Uniform:
+    """Uniform distribution on [``lo``, ``hi``) [SI]."""
+
+    lo: float
+    hi: float
+    signature = "uniform(lo, hi)"
+
+    def __post_init__(self):
+        if not (math.isfinite(self.lo) and math.isfinite(self.hi) and self.lo < self.hi):
+            raise ValueError("uniform(lo, hi) needs finite values and lo < hi")
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        return rng.uniform(self.lo, self.hi, size)
+
+    def identity(self) -> dict:
+        return {"uniform": [self.lo, self.hi]}
+
+    def describe(self) -> str:
+        return f"uniform({self.lo:.6g}, {self.hi:.6g})"
+
+
+def _normal_cdf(x: float) -> float:
+    return 0.5 * math.erfc(-x / math.sqrt(2.0))
+
+
+@dataclass(frozen=True)
+class TruncNormal:
+    """Normal(``mean``, ``sd``) truncated to [``lo``, ``hi``] [SI].
+
+    Drawn by rejection (draw, keep those inside, redraw the rest), so it is exact
+    and reproducible; refused if [lo, hi] holds less than ``TRUNCNORMAL_MIN_MASS``
+    of the untruncated distribution."""
+
+    mean: float
+    sd: float
+    lo: float
+    hi: float
+    signature = "truncnormal(mean, sd, lo, hi)"
+
+    def __post_init__(self):
+        if not all(math.isfinite(v) for v in (self.mean, self.sd, self.lo, self.hi)) or self.sd <= 0 \
+                or not self.lo < self.hi:
+            raise ValueError("truncnormal(mean, sd, lo, hi) needs finite values, sd > 0 and lo < hi")
+        mass = _normal_cdf((self.hi - self.mean) / self.sd) - _normal_cdf((self.lo - self.mean) / self.sd)
+        if mass < TRUNCNORMAL_MIN_MASS:
+            raise ValueError(f"truncnormal: [lo, hi] holds only {mass:.2g} of normal(mean, sd) "
+                             f"(at least {TRUNCNORMAL_MIN_MASS:g} needed)")
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        out = rng.normal(self.mean, self.sd, size)
+        bad = np.flatnonzero((out < self.lo) | (out > self.hi))
+        while bad.size:
+            out[bad] = rng.normal(self.mean, self.sd, bad.size)
+            bad = bad[(out[bad] < self.lo) | (out[bad] > self.hi)]
+        return out
+
+    def identity(self) -> dict:
+        return {"truncnormal": [self.mean, self.sd, self.lo, self.hi]}
+
+    def describe(self) -> str:
+        return f"truncnormal(mean={self.mean:.6g}, sd={self.sd:.6g}, lo={self.lo:.6g}, hi={self.hi:.6g})"
+
+
+@dataclass(frozen=True)
+class Sample:
+    """Bootstrap: members drawn with replacement from measured ``values`` [SI]."""
+
+    source: str
+    values: np.ndarray = field(repr=False)
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        return self.values[rng.integers(0, self.values.size, size)]
+
+    def identity(self) -> dict:
+        digest = hashlib.sha256(np.ascontiguousarray(self.values, dtype=float).tobytes()).hexdigest()
+        return {"sample": self.source, "n": int(self.values.size), "sha256": digest}
+
+    def describe(self) -> str:
+        return f"sample({self.source}, n={self.values.size})"
+
+
+def _read_sample(argument: str, dimension: str, default_column: str | None) -> Sample:
+    """``FILE[:COLUMN]`` → Sample; the column defaults to ``default_column`` or the file's only column."""
+    import pandas as pd
+
+    path, column = argument, None
+    if not Path(path).exists() and ":" in argument:
+        path, column = argument.rsplit(":", 1)
+    if not Path(path).is_file():
+        raise ValueError(f"sample: no such file {path!r}")
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".csv", ".parquet", ".pq"):
+        raise ValueError(f"sample: {path!r} must be .csv or .parquet")
+    frame = pd.read_parquet(path) if suffix != ".csv" else pd.read_csv(path)
+    if column is None:
+        if default_column is not None and default_column in frame:
+            column = default_column
+        elif frame.shape[1] == 1:
+            column = frame.columns[0]
+        else:
+            raise ValueError(f"sample: {path!r} has columns {', '.join(map(str, frame.columns))}; "
+                             f"name one as sample(FILE:COLUMN)")
+    if column not in frame:
+        raise ValueError(f"sample: {path!r} has no column {column!r}")
+    cells = frame[column].dropna()
+    try:
+        values = np.array([parse_quantity(c, dimension) for c in cells], dtype=float) \
+            if cells.dtype.kind not in "fiu" else cells.to_numpy(dtype=float)
+    except ValueError as exc:
+        raise ValueError(f"sample: column {column!r}: {exc}") from None
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise ValueError(f"sample: column {column!r} of {path!r} must hold at least one value, all finite")
+    return Sample(source=f"{path}:{column}", values=values)
+
+
+#: Distribution name → class; every class takes its parameters in its signature's order.
+DISTRIBUTIONS = {"normal": Normal, "lognormal": LogNormal, "uniform": Uniform, "truncnormal": TruncNormal}
+
+
+def parse_distribution(text: str, dimension: str, name: str | None = None):
+    """Parse a spec (see the module docstring) for an input of ``dimension``.
+
+    ``name`` is the input's column name, the default column of ``sample(FILE)``.
+    Returns a distribution object; raises ``ValueError`` with one line."""
+    match = _CALL.match(str(text))
+    if match is None:
+        return Constant(parse_quantity(text, dimension))
+    kind, inner = match.group(1).lower(), match.group(2).strip()
+    if kind == "sample":
+        if not inner:
+            raise ValueError("sample(FILE[:COLUMN]) needs a file")
+        return _read_sample(inner, dimension, name)
+    if kind not in DISTRIBUTIONS:
+        raise ValueError(f"unknown distribution {kind!r} in {text!r} (known: "
+                         + ", ".join([cls.signature for cls in DISTRIBUTIONS.values()] + ["sample(FILE[:COLUMN])"])
+                         + ")")
+    cls = DISTRIBUTIONS[kind]
+    args = [a.strip() for a in inner.split(",")] if inner else []
+    arity = len(cls.__dataclass_fields__)
+    if len(args) != arity:
+        raise ValueError(f"{cls.signature} takes {arity} values; got {len(args)} in {text!r}")
+    dimensionless = getattr(cls, "dimensionless", ())
+    values = [parse_quantity(a, "dimensionless" if i in dimensionless else dimension) for i, a in enumerate(args)]
+    return cls(*values)
+
+
+__all__ = ["Constant", "Normal", "LogNormal", "Uniform", "TruncNormal", "Sample", "DISTRIBUTIONS",
+           "TRUNCNORMAL_MIN_MASS", "parse_distribution"]
