@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .batch import INPUT_COLUMNS, TEXT_COLUMNS
-from .units import UNITS, parse_quantity
+from .units import parse_quantity
 
 #: Rows per chunk by default: large enough that the per-chunk overhead is small next to evaluation.
 CHUNK_ROWS = 500_000
@@ -283,10 +283,7 @@ class TableSource:
             yield index, pa.Table.from_batches(pending).to_pandas().rename(columns=_column_name)
 
     def inputs(self, start: int, stop: int, payload):
-        for name in TEXT_COLUMNS:  # an all-empty text column reads as float NaN: make it text
-            if name in payload and payload[name].dtype.kind == "f":
-                payload[name] = payload[name].astype(object)
-        return payload
+        return payload  # batch.evaluate reads text columns of any dtype
 
 
 def known_order() -> list[str]:
@@ -506,12 +503,11 @@ def _frame_table(frame):
 def evaluate_rows(inputs, start: int):
     """``batch.evaluate`` of ``inputs`` with a ``row`` column (row numbers from ``start``) in front.
 
-    Column names are unique (Parquet needs it): should ``evaluate`` ever repeat
-    one, the later copy is kept."""
+    Power-law rows always use the engine's table, so results do not depend on
+    where the chunk boundaries fall."""
     from .batch import evaluate
 
-    result = evaluate(inputs)
-    result = result.loc[:, ~result.columns.duplicated(keep="last")]
+    result = evaluate(inputs, tabulated=True)
     result.insert(0, "row", np.arange(start, start + len(result), dtype=np.int64))
     return result
 
