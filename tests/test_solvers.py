@@ -154,5 +154,6 @@ def test_peak_force_rises_with_velocity_and_stiffness(fruit, velocity, factor, d
                           poisson=fruit.poisson, stiffness=k_c * factor)
     # same λ: α' = λ/(1.5 k_c')
     stiffer = simulate(stiffer_fruit, velocity=velocity, alpha=lam / (1.5 * k_c * factor), calibration="paper")
-    assert stiffer.law.damping == pytest.approx(lam, rel=1e-12)
+    # α → k = 1 - α V → λ loses digits as α V → 0 (1 - (1 - αV)); 1e-9 is ample here
+    assert stiffer.law.damping == pytest.approx(lam, rel=1e-9, abs=1e-12 * k_c)
     assert stiffer.characteristics.peak_force > base.characteristics.peak_force

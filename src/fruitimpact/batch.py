@@ -181,6 +181,7 @@ def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noq
             result = adaptive_characteristics(np.full(len(idx), law.family), params, np.full(len(idx), law.clamp),
                                               m, v, r, ADAPTIVE_RTOL)
         out[idx] = result
+    out[np.isinf(out[:, 10]), 10] = np.nan  # unbounded Hertz pressure at first touch: undefined (solvers._judge)
     computed = valid & ~np.all(np.isfinite(out[:, [0, 2, 3, 6]]), axis=1)  # as solvers._judge
     status[computed] = "failed"
     messages[computed] = "solver did not reach separation (non-finite characteristics)"

@@ -61,12 +61,17 @@ def _judge(values):
     """(values, success, message): success needs the essential characteristics
     finite; a peak at first touch (a dashpot's force jump) leaves C and C*
     undefined, which is reported, not failed."""
-    values = tuple(float(v) for v in values)
+    values = [float(v) for v in values]
     if not all(np.isfinite(values[i]) for i in _ESSENTIAL):
-        return values, False, "solver produced non-finite characteristics"
+        return tuple(values), False, "solver produced non-finite characteristics"
+    notes = []
     if values[1] == 0.0:
-        return values, True, "peak force at first touch (force jump of the dashpot): C and C* undefined"
-    return values, True, "ok"
+        notes.append("peak force at first touch (force jump of the dashpot): C and C* undefined")
+    if np.isinf(values[10]):
+        values[10] = math.nan
+        notes.append("max_pressure undefined: the damping force does not vanish with δ at first touch, "
+                     "so the Hertz pressure 3F/(2πRδ) is unbounded there")
+    return tuple(values), True, "; ".join(notes) or "ok"
 
 
 def _accurate_curves(law, mass, velocity, step, points):

@@ -20,17 +20,31 @@ deflection) and rtol·v0 for δ̇, so ``rtol`` is a relative accuracy of the
 characteristics.  Step-size control as in DOP853 (safety 0.9, factors
 0.2–10, no growth right after a rejection).
 
-The force laws with δ^0.5 or δ^0.25 factors make the right-hand side
-non-smooth at δ = 0 (first touch and, unclamped, separation); there the
-controller simply takes small steps (the local error of a step [t, t + h]
-near the singular point is O(t^q h^p), so the steps grow geometrically
-away from it: a few tens of extra stage evaluations per impact).
+The laws with δ^0.5 or δ^0.25 factors (and δ^n) make the motion
+non-smooth in t at δ = 0: near first touch and separation δ(t) is a series
+in t^(1/4) or t^(1/2), and an explicit RK method crawls there.  So the
+impact is integrated in three phases (``_integrate``):
+
+A. from first touch until δ = 0.1·δ_ref (or δ̇ = v0/2), in σ = δ^(1/q)
+   with state (t, δ̇): dt/dσ = qσ^(q-1)/δ̇, dδ̇/dσ = -qσ^(q-1) F/(m δ̇),
+   q = 4 for δ^0.25, 2 for δ^0.5 and δ^1.5, 1 for Kelvin–Voigt, where the
+   laws are polynomials in σ and the motion is smooth (δ̇ stays ≥ v0/2);
+B. in t with state (δ, δ̇) through the maximum deflection;
+C. in σ again from δ ≈ 0.3·δ_max in restitution down to σ = 0 exactly:
+   separation is the end of the interval, not an event on a singular curve.
+
+Clamped laws are integrated unclamped: until separation they coincide
+(the force is positive in compression and contact ends where it first
+vanishes), and the smooth continuation puts the release event on a smooth
+interpolant instead of across a kink.
 
 Events are located on the dense output of the step in which they occur, by
 a bracketing (Illinois) root finder, never read off a grid:
 
-* separation: δ(t) = 0, or, clamped, the unclamped force F(t) = 0 while
-  δ̇ < 0, whichever comes first; the exit velocity is δ̇ there;
+* separation: σ = 0 (the end of phase C), or, clamped, the unclamped force
+  F = 0 while δ̇ < 0 if that comes first (located as the sign change of F
+  divided by its lowest power of δ, ``_release``); the exit velocity is δ̇
+  there;
 * maximum deflection: δ̇(t) = 0;
 * peak force: dF/dt = ∂F/∂δ·δ̇ + ∂F/∂δ̇·δ̈ = 0 (analytic, with δ̈ = -F/m),
   crossing from + to -; the force at first touch (b·v0 for Kelvin–Voigt)
@@ -196,6 +210,22 @@ def _rates(family, params, clamp, inv_mass, d, v):
 
 
 @nb.njit(**_JIT)
+def _release(family, params, d, v):
+    """The unclamped force divided by its lowest power of δ (δ^n, 1, δ^0.5,
+    δ^0.25): same sign as F for δ > 0, but not forced to 0 at δ = 0, so that
+    a clamped law's release (F = 0 at δ > 0) is a simple sign change."""
+    if d < 0.0:
+        d = 0.0
+    if family == POWER_LAW:
+        return params[0] * (1.0 + params[2] * v)
+    if family == KELVIN_VOIGT:
+        return params[0] * d + params[1] * v
+    if family == KUWABARA_KONO:
+        return params[0] * (d + params[1] * v)
+    return params[0] * d * math.sqrt(math.sqrt(d)) + params[1] * v
+
+
+@nb.njit(**_JIT)
 def _ratio_limit(family, params, clamp, rate):
     """lim F/δ [N/m] as δ → 0+ at rate δ̇ (±inf where unbounded)."""
     if family == POWER_LAW:
@@ -219,89 +249,179 @@ def _ratio_limit(family, params, clamp, rate):
 
 
 @nb.njit(**_JIT)
-def _step(family, params, clamp, inv_mass, d, v, h, kd, kv):
-    """One DOP853 step from (δ, δ̇) with kd[0], kv[0] = f(δ, δ̇) set.
-    Fills stages 1–12 (12: f at the new point) and returns the new state."""
-    for s in range(1, 12):
-        sd = 0.0
-        sv = 0.0
-        for j in range(s):
-            a = _A[s, j]
-            sd += a * kd[j]
-            sv += a * kv[j]
-        vs = v + h * sv
-        kd[s] = vs
-        kv[s] = -contact_force(family, params, d + h * sd, vs, clamp) * inv_mass
-    sd = 0.0
-    sv = 0.0
-    for j in range(12):
-        sd += _B[j] * kd[j]
-        sv += _B[j] * kv[j]
-    d_new = d + h * sd
-    v_new = v + h * sv
-    kd[12] = v_new
-    kv[12] = -contact_force(family, params, d_new, v_new, clamp) * inv_mass
-    return d_new, v_new
+def _substitution_power(family, params):
+    """Integer q of the substitution δ = σ^q that makes the law a smooth
+    (polynomial) function of σ near δ = 0: δ^0.5 → q = 2, δ^0.25 → q = 4."""
+    if family == KELVIN_VOIGT:
+        return 1
+    if family == KUWABARA_KONO:
+        return 2
+    if family == POWER_LAW:
+        n = params[1]
+        if n == math.floor(n):
+            return 1
+        if 2.0 * n == math.floor(2.0 * n):
+            return 2
+    return 4
 
 
 @nb.njit(**_JIT)
-def _error_norm(kd, kv, h, scale_d, scale_v):
+def _rhs(mode, q, family, params, inv_mass, x, y1, y2):
+    """Right-hand side.  mode 0: x = t, y = (δ, δ̇), y' = (δ̇, -F/m).
+    mode 1: x = σ = δ^(1/q), y = (t, δ̇), dy/dσ = (1, -F/m)·q σ^(q-1)/δ̇.
+    F is the unclamped law: until separation a clamped law equals it (it is
+    positive in compression, and contact ends where it first vanishes in
+    restitution), and its smooth continuation past that event lets the
+    event be located on a smooth interpolant instead of across a kink."""
+    if mode == 0:
+        return y2, -contact_force(family, params, y1, y2, False) * inv_mass
+    s = x if x > 0.0 else 0.0
+    if q == 1:
+        p = 1.0
+    elif q == 2:
+        p = s
+    else:
+        p = s * s * s
+    w = q * p / y2
+    return w, -contact_force(family, params, p * s, y2, False) * inv_mass * w
+
+
+@nb.njit(**_JIT)
+def _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2):
+    """One DOP853 step of size h from (x, y) with k1[0], k2[0] = f(x, y) set.
+    Fills stages 1–12 (12: f at the new point) and returns the new y.
+    Written out over the nonzero coefficients: twice as fast as loops."""
+    a0 = k1[0]
+    b0 = k2[0]
+    d1 = y1 + h * (_A[1, 0] * a0)
+    d2 = y2 + h * (_A[1, 0] * b0)
+    a1, b1 = _rhs(mode, q, family, params, inv_mass, x + _C[1] * h, d1, d2)
+    d1 = y1 + h * (_A[2, 0] * a0 + _A[2, 1] * a1)
+    d2 = y2 + h * (_A[2, 0] * b0 + _A[2, 1] * b1)
+    a2, b2 = _rhs(mode, q, family, params, inv_mass, x + _C[2] * h, d1, d2)
+    d1 = y1 + h * (_A[3, 0] * a0 + _A[3, 2] * a2)
+    d2 = y2 + h * (_A[3, 0] * b0 + _A[3, 2] * b2)
+    a3, b3 = _rhs(mode, q, family, params, inv_mass, x + _C[3] * h, d1, d2)
+    d1 = y1 + h * (_A[4, 0] * a0 + _A[4, 2] * a2 + _A[4, 3] * a3)
+    d2 = y2 + h * (_A[4, 0] * b0 + _A[4, 2] * b2 + _A[4, 3] * b3)
+    a4, b4 = _rhs(mode, q, family, params, inv_mass, x + _C[4] * h, d1, d2)
+    d1 = y1 + h * (_A[5, 0] * a0 + _A[5, 3] * a3 + _A[5, 4] * a4)
+    d2 = y2 + h * (_A[5, 0] * b0 + _A[5, 3] * b3 + _A[5, 4] * b4)
+    a5, b5 = _rhs(mode, q, family, params, inv_mass, x + _C[5] * h, d1, d2)
+    d1 = y1 + h * (_A[6, 0] * a0 + _A[6, 3] * a3 + _A[6, 4] * a4 + _A[6, 5] * a5)
+    d2 = y2 + h * (_A[6, 0] * b0 + _A[6, 3] * b3 + _A[6, 4] * b4 + _A[6, 5] * b5)
+    a6, b6 = _rhs(mode, q, family, params, inv_mass, x + _C[6] * h, d1, d2)
+    d1 = y1 + h * (_A[7, 0] * a0 + _A[7, 3] * a3 + _A[7, 4] * a4 + _A[7, 5] * a5 + _A[7, 6] * a6)
+    d2 = y2 + h * (_A[7, 0] * b0 + _A[7, 3] * b3 + _A[7, 4] * b4 + _A[7, 5] * b5 + _A[7, 6] * b6)
+    a7, b7 = _rhs(mode, q, family, params, inv_mass, x + _C[7] * h, d1, d2)
+    d1 = y1 + h * (_A[8, 0] * a0 + _A[8, 3] * a3 + _A[8, 4] * a4 + _A[8, 5] * a5 + _A[8, 6] * a6
+            + _A[8, 7] * a7)
+    d2 = y2 + h * (_A[8, 0] * b0 + _A[8, 3] * b3 + _A[8, 4] * b4 + _A[8, 5] * b5 + _A[8, 6] * b6
+            + _A[8, 7] * b7)
+    a8, b8 = _rhs(mode, q, family, params, inv_mass, x + _C[8] * h, d1, d2)
+    d1 = y1 + h * (_A[9, 0] * a0 + _A[9, 3] * a3 + _A[9, 4] * a4 + _A[9, 5] * a5 + _A[9, 6] * a6
+            + _A[9, 7] * a7 + _A[9, 8] * a8)
+    d2 = y2 + h * (_A[9, 0] * b0 + _A[9, 3] * b3 + _A[9, 4] * b4 + _A[9, 5] * b5 + _A[9, 6] * b6
+            + _A[9, 7] * b7 + _A[9, 8] * b8)
+    a9, b9 = _rhs(mode, q, family, params, inv_mass, x + _C[9] * h, d1, d2)
+    d1 = y1 + h * (_A[10, 0] * a0 + _A[10, 3] * a3 + _A[10, 4] * a4 + _A[10, 5] * a5 + _A[10, 6] * a6
+            + _A[10, 7] * a7 + _A[10, 8] * a8 + _A[10, 9] * a9)
+    d2 = y2 + h * (_A[10, 0] * b0 + _A[10, 3] * b3 + _A[10, 4] * b4 + _A[10, 5] * b5 + _A[10, 6] * b6
+            + _A[10, 7] * b7 + _A[10, 8] * b8 + _A[10, 9] * b9)
+    a10, b10 = _rhs(mode, q, family, params, inv_mass, x + _C[10] * h, d1, d2)
+    d1 = y1 + h * (_A[11, 0] * a0 + _A[11, 3] * a3 + _A[11, 4] * a4 + _A[11, 5] * a5 + _A[11, 6] * a6
+            + _A[11, 7] * a7 + _A[11, 8] * a8 + _A[11, 9] * a9 + _A[11, 10] * a10)
+    d2 = y2 + h * (_A[11, 0] * b0 + _A[11, 3] * b3 + _A[11, 4] * b4 + _A[11, 5] * b5 + _A[11, 6] * b6
+            + _A[11, 7] * b7 + _A[11, 8] * b8 + _A[11, 9] * b9 + _A[11, 10] * b10)
+    a11, b11 = _rhs(mode, q, family, params, inv_mass, x + _C[11] * h, d1, d2)
+    y1_new = y1 + h * (_B[0] * a0 + _B[5] * a5 + _B[6] * a6 + _B[7] * a7 + _B[8] * a8 + _B[9] * a9
+            + _B[10] * a10 + _B[11] * a11)
+    y2_new = y2 + h * (_B[0] * b0 + _B[5] * b5 + _B[6] * b6 + _B[7] * b7 + _B[8] * b8 + _B[9] * b9
+            + _B[10] * b10 + _B[11] * b11)
+    a12, b12 = _rhs(mode, q, family, params, inv_mass, x + h, y1_new, y2_new)
+    k1[1] = a1
+    k2[1] = b1
+    k1[2] = a2
+    k2[2] = b2
+    k1[3] = a3
+    k2[3] = b3
+    k1[4] = a4
+    k2[4] = b4
+    k1[5] = a5
+    k2[5] = b5
+    k1[6] = a6
+    k2[6] = b6
+    k1[7] = a7
+    k2[7] = b7
+    k1[8] = a8
+    k2[8] = b8
+    k1[9] = a9
+    k2[9] = b9
+    k1[10] = a10
+    k2[10] = b10
+    k1[11] = a11
+    k2[11] = b11
+    k1[12] = a12
+    k2[12] = b12
+    return y1_new, y2_new
+
+
+@nb.njit(**_JIT)
+def _error_norm(k1, k2, h, scale1, scale2):
     """DOP853's combined 5th/3rd-order error estimate (≤ 1: accept)."""
-    e5d = 0.0
-    e5v = 0.0
-    e3d = 0.0
-    e3v = 0.0
-    for j in range(13):
-        e5d += _E5[j] * kd[j]
-        e5v += _E5[j] * kv[j]
-        e3d += _E3[j] * kd[j]
-        e3v += _E3[j] * kv[j]
-    e5d /= scale_d
-    e5v /= scale_v
-    e3d /= scale_d
-    e3v /= scale_v
-    err5 = e5d * e5d + e5v * e5v
-    err3 = e3d * e3d + e3v * e3v
+    e51 = 0.0
+    e52 = 0.0
+    e31 = 0.0
+    e32 = 0.0
+    for j in range(12):
+        e51 += _E5[j] * k1[j]
+        e52 += _E5[j] * k2[j]
+        e31 += _E3[j] * k1[j]
+        e32 += _E3[j] * k2[j]
+    e51 /= scale1
+    e52 /= scale2
+    e31 /= scale1
+    e32 /= scale2
+    err5 = e51 * e51 + e52 * e52
+    err3 = e31 * e31 + e32 * e32
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
     return abs(h) * err5 / math.sqrt((err5 + 0.01 * err3) * 2.0)
 
 
 @nb.njit(**_JIT)
-def _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv):
+def _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2):
     """Coefficients of DOP853's 7th-order interpolant on the last step
     (three more stages)."""
     for s in range(13, 16):
-        sd = 0.0
-        sv = 0.0
+        s1 = 0.0
+        s2 = 0.0
         for j in range(s):
             a = _A[s, j]
-            sd += a * kd[j]
-            sv += a * kv[j]
-        vs = v + h * sv
-        kd[s] = vs
-        kv[s] = -contact_force(family, params, d + h * sd, vs, clamp) * inv_mass
-    dd = d_new - d
-    dv = v_new - v
-    cd[0] = dd
-    cv[0] = dv
-    cd[1] = h * kd[0] - dd
-    cv[1] = h * kv[0] - dv
-    cd[2] = 2.0 * dd - h * (kd[12] + kd[0])
-    cv[2] = 2.0 * dv - h * (kv[12] + kv[0])
+            s1 += a * k1[j]
+            s2 += a * k2[j]
+        k1[s], k2[s] = _rhs(mode, q, family, params, inv_mass, x + _C[s] * h, y1 + h * s1, y2 + h * s2)
+    d1 = y1_new - y1
+    d2 = y2_new - y2
+    c1[0] = d1
+    c2[0] = d2
+    c1[1] = h * k1[0] - d1
+    c2[1] = h * k2[0] - d2
+    c1[2] = 2.0 * d1 - h * (k1[12] + k1[0])
+    c2[2] = 2.0 * d2 - h * (k2[12] + k2[0])
     for i in range(4):
-        sd = 0.0
-        sv = 0.0
+        s1 = 0.0
+        s2 = 0.0
         for j in range(16):
-            sd += _D[i, j] * kd[j]
-            sv += _D[i, j] * kv[j]
-        cd[3 + i] = h * sd
-        cv[3 + i] = h * sv
+            s1 += _D[i, j] * k1[j]
+            s2 += _D[i, j] * k2[j]
+        c1[3 + i] = h * s1
+        c2[3 + i] = h * s2
 
 
 @nb.njit(**_JIT)
 def _dense(theta, y0, coef):
-    """Interpolant at θ = (t - t_old)/h in [0, 1]."""
+    """Interpolant at θ = (x - x_old)/h in [0, 1]."""
     y = 0.0
     for i in range(6, -1, -1):
         y += coef[i]
@@ -313,26 +433,38 @@ def _dense(theta, y0, coef):
 
 
 @nb.njit(**_JIT)
-def _event(kind, theta, family, params, clamp, inv_mass, d0, v0, cd, cv):
-    """Event function on the interpolant: 0 δ, 1 δ̇, 2 δ·dF/dt,
-    3 δ²·d(F/δ)/dt, 4 unclamped F."""
-    d = _dense(theta, d0, cd)
-    if kind == 0:
-        return d
-    v = _dense(theta, v0, cv)
+def _state(mode, q, theta, x, h, y1, y2, c1, c2):
+    """(t, δ, δ̇) at θ on the interpolant of the last step."""
+    a = _dense(theta, y1, c1)
+    v = _dense(theta, y2, c2)
+    if mode == 0:
+        return x + theta * h, a, v
+    s = x + theta * h
+    if s < 0.0:
+        s = 0.0
+    return a, s ** q, v
+
+
+@nb.njit(**_JIT)
+def _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
+    """Event function at θ: 1 δ̇, 2 δ·dF/dt, 3 δ²·d(F/δ)/dt, 4 the sign of
+    the unclamped F (``_release``), 5 t - target."""
+    t, d, v = _state(mode, q, theta, x, h, y1, y2, c1, c2)
     if kind == 1:
         return v
     if kind == 4:
-        return contact_force(family, params, d, v, False)
+        return _release(family, params, d, v)
+    if kind == 5:
+        return t - target
     force, g, hp = _rates(family, params, clamp, inv_mass, d, v)
     return g if kind == 2 else hp
 
 
 @nb.njit(**_JIT)
-def _root(kind, lo, f_lo, hi, f_hi, family, params, clamp, inv_mass, d0, v0, cd, cv):
+def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
     """θ in [lo, hi] where event ``kind`` changes sign (f_lo, f_hi of
     opposite signs or zero), by the Illinois variant of regula falsi,
-    to full double precision in θ."""
+    to 1e-13 in θ (the step is a fraction of the contact)."""
     if f_lo == 0.0:
         return lo
     if f_hi == 0.0:
@@ -343,7 +475,7 @@ def _root(kind, lo, f_lo, hi, f_hi, family, params, clamp, inv_mass, d0, v0, cd,
         theta = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
         if not (lo < theta < hi):
             theta = 0.5 * (lo + hi)
-        f = _event(kind, theta, family, params, clamp, inv_mass, d0, v0, cd, cv)
+        f = _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
         if f == 0.0:
             return theta
         if (f > 0.0) == (f_hi > 0.0):
@@ -358,32 +490,39 @@ def _root(kind, lo, f_lo, hi, f_hi, family, params, clamp, inv_mass, d0, v0, cd,
             if side == -1:
                 f_hi *= 0.5
             side = -1
-        if hi - lo <= 4e-16 * max(1.0, abs(hi)):
+        if hi - lo <= 1e-13:  # θ; event times to ~1e-14 of the contact
             break
     return theta
 
 
+#: Phase switches: first-touch phase in σ until δ = _SWITCH_A·δ_ref (or δ̇
+#: has fallen to half of v0); last phase in σ from δ ≈ _SWITCH_C·δ_max.
+_SWITCH_A = 0.1
+_SWITCH_C = 0.3
+
+
 @nb.njit(**_JIT)
 def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
-               times, curve_d, curve_v, curve_f):
+               times, curve_d, curve_v, curve_f, work):
     """Integrate one impact; fill ``out`` (characteristics) and, at the
     ascending ``times`` [s], the curves.  Returns the number of accepted
-    steps, or -1 (too many steps) / -2 (step size underflow)."""
+    steps, or -1 (too many steps) / -2 (step size underflow).
+
+    Three phases: (A) from first touch in σ = δ^(1/q), state (t, δ̇);
+    (B) in time, state (δ, δ̇), through the maximum deflection; (C) in σ
+    again, down to σ = 0 (separation) unless a clamped force vanishes first.
+    In σ the laws are polynomials and the motion is smooth up to δ = 0."""
     inv_mass = 1.0 / mass
-    scale_d = rtol * _deflection_scale(family, params, mass, velocity)
+    q = _substitution_power(family, params)
+    delta_ref = _deflection_scale(family, params, mass, velocity)
+    time_scale = delta_ref / velocity
     scale_v = rtol * velocity
-    kd = np.empty(16)
-    kv = np.empty(16)
-    cd = np.empty(7)
-    cv = np.empty(7)
+    k1 = work[0:16]  # stages
+    k2 = work[16:32]
+    c1 = work[32:39]  # interpolant coefficients
+    c2 = work[39:46]
 
-    t = 0.0
-    d = 0.0
-    v = velocity
     force0 = contact_force(family, params, 0.0, velocity, clamp)
-    kd[0] = v
-    kv[0] = -force0 * inv_mass
-
     peak_force = force0
     time_to_peak = 0.0
     max_deflection = 0.0
@@ -404,76 +543,116 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         curve_f[ti] = force0
         ti += 1
 
-    time_scale = scale_d / scale_v  # δ_ref / v0
-    h = 1e-3 * time_scale
+    # phase A: x = σ, y = (t, δ̇)
+    phase = 0
+    mode = 1
+    x = 0.0
+    y1 = 0.0
+    y2 = velocity
+    sigma_end = (_SWITCH_A * delta_ref) ** (1.0 / q)
+    scale1 = rtol * time_scale
+    k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+    h = sigma_end
     rejected = False
     steps = 0
     while steps < MAX_STEPS:
-        d_new, v_new = _step(family, params, clamp, inv_mass, d, v, h, kd, kv)
-        err = _error_norm(kd, kv, h, scale_d, scale_v)
+        clipped = False
+        if phase == 0 and x + h >= sigma_end:
+            h = sigma_end - x
+            clipped = True
+        elif phase == 2 and x + h <= 0.0:
+            h = -x
+            clipped = True
+        elif phase == 1 and y2 < 0.0 and max_deflection > 0.0:
+            # restitution: do not step past δ = 0.6·δ_switch (the motion is
+            # not smooth at δ = 0); δ + v h - ½|a| h² = target
+            gap = y1 - 0.6 * _SWITCH_C * max_deflection
+            if gap > 0.0:
+                reach = 2.0 * gap / (-y2 + math.sqrt(y2 * y2 + 2.0 * abs(k2[0]) * gap))
+                if h > reach:
+                    h = reach
+        y1_new, y2_new = _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2)
+        err = _error_norm(k1, k2, h, scale1, scale_v)
         if not (err <= 1.0):  # also catches NaN
-            if err != err:
-                factor = _MIN_FACTOR
-            else:
-                factor = max(_MIN_FACTOR, _SAFETY * err ** -0.125)
+            factor = _MIN_FACTOR if err != err else max(_MIN_FACTOR, _SAFETY * err ** -0.125)
             h *= factor
             rejected = True
-            if h <= 1e-14 * max(t, time_scale):
+            if abs(h) <= 1e-14 * (abs(x) + abs(h) / factor):
                 break
             continue
+
+        # state at the end of the step
+        if mode == 0:
+            t_new = x + h
+            d_new = y1_new
+        else:
+            t_new = y1_new
+            s_new = x + h if not clipped or phase == 0 else 0.0
+            d_new = s_new ** q
+        v_new = y2_new
+        f_raw = _release(family, params, d_new, v_new)
+        ended = clamp and f_raw <= 0.0 and v_new < 0.0
+        if not ended and phase == 1 and v_new < 0.0 and d_new < _SWITCH_C * max_deflection:
+            # entering the last phase: land in (0.3, 1)·δ_switch, not past separation
+            if d_new < 0.3 * _SWITCH_C * max_deflection:
+                h *= max(0.05, (y1 - 0.6 * _SWITCH_C * max_deflection) / (y1 - d_new))
+                rejected = True
+                continue
         steps += 1
 
-        # ---- events in the accepted step [t, t + h] ----
+        # ---- events in the accepted step ----
         dense_ready = False
-        f_raw = contact_force(family, params, d_new, v_new, False)
-        ended = d_new <= 0.0 or (clamp and f_raw <= 0.0 and v_new < 0.0)
         theta_end = 1.0
+        t_end = t_new
         d_end = d_new
         v_end = v_new
-        if ended:
-            _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+        if ended:  # clamped force vanishes: separation with δ > 0
+            _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
             dense_ready = True
-            touching = True  # separation where δ = 0 (else where the unclamped F = 0)
-            if d_new <= 0.0:
-                theta_end = _root(0, 0.0, d, 1.0, d_new, family, params, clamp, inv_mass, d, v, cd, cv)
-            if clamp and f_raw <= 0.0:
-                f_start = contact_force(family, params, d, v, False)
-                theta_f = _root(4, 0.0, f_start, 1.0, f_raw, family, params, clamp, inv_mass, d, v, cd, cv)
-                if theta_f < theta_end:
-                    theta_end = theta_f
-                    touching = False
-            d_end = 0.0 if touching else max(_dense(theta_end, d, cd), 0.0)
-            v_end = _dense(theta_end, v, cv)
+            d_start = y1 if mode == 0 else x ** q
+            f_start = _release(family, params, d_start, y2)
+            theta_end = _root(4, 0.0, f_start, 1.0, f_raw, 0.0, mode, q, family, params, clamp, inv_mass,
+                              x, h, y1, y2, c1, c2)
+            t_end, d_end, v_end = _state(mode, q, theta_end, x, h, y1, y2, c1, c2)
+            d_end = max(d_end, 0.0)
+        elif phase == 2 and clipped:  # σ = 0: separation at δ = 0
+            ended = True
+            d_end = 0.0
 
-        if v > 0.0 and v_end <= 0.0:  # maximum deflection
+        if mode == 0 and y2 > 0.0 and v_end <= 0.0:  # maximum deflection
             if not dense_ready:
-                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                             k1, k2, c1, c2)
                 dense_ready = True
-            theta = _root(1, 0.0, v, theta_end, v_end, family, params, clamp, inv_mass, d, v, cd, cv)
-            max_deflection = _dense(theta, d, cd)
-            time_to_max = t + theta * h
+            theta = _root(1, 0.0, y2, theta_end, v_end, 0.0, mode, q, family, params, clamp, inv_mass,
+                          x, h, y1, y2, c1, c2)
+            time_to_max, max_deflection, _v = _state(mode, q, theta, x, h, y1, y2, c1, c2)
 
         force_end, g_end, h_end = _rates(family, params, clamp, inv_mass, d_end, v_end)
         if g_old > 0.0 and g_end < 0.0:  # local maximum of F
             if not dense_ready:
-                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                             k1, k2, c1, c2)
                 dense_ready = True
-            g_start = _event(2, 0.0, family, params, clamp, inv_mass, d, v, cd, cv)
-            theta = _root(2, 0.0, g_start, theta_end, g_end, family, params, clamp, inv_mass, d, v, cd, cv)
-            dd = _dense(theta, d, cd)
-            force = contact_force(family, params, dd, _dense(theta, v, cv), clamp)
+            g_start = _event(2, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+            theta = _root(2, 0.0, g_start, theta_end, g_end, 0.0, mode, q, family, params, clamp, inv_mass,
+                          x, h, y1, y2, c1, c2)
+            tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
+            force = contact_force(family, params, dd, vv, clamp)
             if force > peak_force:
                 peak_force = force
-                time_to_peak = t + theta * h
+                time_to_peak = tt
         if h_old > 0.0 and h_end < 0.0:  # local maximum of F/δ
             if not dense_ready:
-                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                             k1, k2, c1, c2)
                 dense_ready = True
-            h_start = _event(3, 0.0, family, params, clamp, inv_mass, d, v, cd, cv)
-            theta = _root(3, 0.0, h_start, theta_end, h_end, family, params, clamp, inv_mass, d, v, cd, cv)
-            dd = _dense(theta, d, cd)
+            h_start = _event(3, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+            theta = _root(3, 0.0, h_start, theta_end, h_end, 0.0, mode, q, family, params, clamp, inv_mass,
+                          x, h, y1, y2, c1, c2)
+            tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
             if dd > 0.0:
-                ratio = contact_force(family, params, dd, _dense(theta, v, cv), clamp) / dd
+                ratio = contact_force(family, params, dd, vv, clamp) / dd
                 if ratio > max_ratio:
                     max_ratio = ratio
         if g_end != 0.0:
@@ -481,14 +660,17 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         if h_end != 0.0:
             h_old = h_end
 
-        t_end = t + theta_end * h
         while ti < n_times and times[ti] < t_end:
             if not dense_ready:
-                _dense_setup(family, params, clamp, inv_mass, d, v, h, d_new, v_new, kd, kv, cd, cv)
+                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                             k1, k2, c1, c2)
                 dense_ready = True
-            theta = (times[ti] - t) / h
-            dd = _dense(theta, d, cd)
-            vv = _dense(theta, v, cv)
+            if mode == 0:
+                theta = (times[ti] - x) / h
+            else:
+                theta = _root(5, 0.0, y1 - times[ti], theta_end, t_end - times[ti], times[ti], mode, q,
+                              family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+            tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
             curve_d[ti] = max(dd, 0.0)
             curve_v[ti] = vv
             curve_f[ti] = contact_force(family, params, dd, vv, clamp)
@@ -520,17 +702,37 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             out[11] = math.sqrt(radius * max_deflection)
             return steps
 
-        # ---- advance ----
-        t += h
-        d = d_new
-        v = v_new
-        kd[0] = kd[12]
-        kv[0] = kv[12]
+        # ---- advance, switching phase where due ----
         factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, _SAFETY * err ** -0.125)
         if rejected:
             factor = min(1.0, factor)
             rejected = False
-        h *= factor
+        if phase == 0 and (clipped or v_new <= 0.5 * velocity):
+            # to time: dt = (dt/dσ) dσ
+            h = factor * h * q * (x + h) ** (q - 1) / v_new
+            phase = 1
+            mode = 0
+            x = t_new
+            y1 = d_new
+            y2 = v_new
+            scale1 = rtol * delta_ref
+            k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+        elif phase == 1 and v_new < 0.0 and d_new < _SWITCH_C * max_deflection:
+            phase = 2
+            mode = 1
+            x = d_new ** (1.0 / q)
+            h = -factor * h * abs(v_new) / (q * x ** (q - 1))
+            y1 = t_new
+            y2 = v_new
+            scale1 = rtol * time_scale
+            k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+        else:
+            x += h
+            y1 = y1_new
+            y2 = y2_new
+            k1[0] = k1[12]
+            k2[0] = k2[12]
+            h *= factor
 
     for j in range(out.shape[0]):
         out[j] = math.nan
@@ -539,6 +741,10 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         curve_v[j] = math.nan
         curve_f[j] = math.nan
     return -1 if steps >= MAX_STEPS else -2
+
+
+_WORK = 46  # workspace: 2 × 16 stages, 2 × 7 interpolant coefficients
+_CHUNK = 64  # impacts per parallel work item
 
 
 @nb.njit(**_JIT)
@@ -554,21 +760,29 @@ def adaptive_impact(family, params, clamp, mass, velocity, radius, rtol, out):
     Fills ``out`` (length ≥ 12) in the order of ``CHARACTERISTIC_COLUMNS``.
     Returns the number of accepted steps (> 0), or a negative number (and
     NaNs in ``out``) if the integration failed."""
-    none = out[:0]  # no curve samples (an empty, writable view: no allocation)
-    return _integrate(family, params, clamp, mass, velocity, radius, rtol, out, none, none, none, none)
+    none = out[:0]  # no curve samples (an empty, writable view)
+    return _integrate(family, params, clamp, mass, velocity, radius, rtol, out, none, none, none, none,
+                      np.empty(_WORK))
 
 
 @nb.njit(parallel=True, **_JIT)
 def adaptive_batch(family, params, clamp, mass, velocity, radius, rtol, out):
     """Characteristics of many impacts: row i uses family[i], params[i, :],
     clamp[i], mass[i], velocity[i], radius[i] and fills out[i, :]."""
-    for i in nb.prange(mass.shape[0]):
-        adaptive_impact(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], rtol, out[i])
+    rows = mass.shape[0]
+    n_chunks = (rows + _CHUNK - 1) // _CHUNK
+    for chunk in nb.prange(n_chunks):
+        work = np.empty(_WORK)  # one workspace per chunk: no allocation per impact
+        for i in range(chunk * _CHUNK, min(rows, (chunk + 1) * _CHUNK)):
+            none = out[i, :0]
+            _integrate(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], rtol, out[i],
+                       none, none, none, none, work)
 
 
 @nb.njit(**_JIT)
 def _curves_kernel(family, params, clamp, mass, velocity, rtol, times, deflection, rate, force, out):
-    return _integrate(family, params, clamp, mass, velocity, 1.0, rtol, out, times, deflection, rate, force)
+    return _integrate(family, params, clamp, mass, velocity, 1.0, rtol, out, times, deflection, rate, force,
+                      np.empty(_WORK))
 
 
 def adaptive_characteristics(family, params, clamp, mass, velocity, radius,
