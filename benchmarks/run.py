@@ -153,11 +153,16 @@ def main(argv=None):
     args = parser.parse_args(argv)
     rows = []
 
-    def record(task, fruitimpact_value, baseline_name, baseline_value, unit, note):
-        ratio = baseline_value / fruitimpact_value if unit.startswith("µs") or unit == "s" else fruitimpact_value / baseline_value
+    def record(task, fruitimpact_value, baseline_name, baseline_value, unit, note, compare=True):
+        if not compare:  # a reference point, not a competitor
+            ratio = "–"
+        elif unit.startswith("µs"):
+            ratio = f"{baseline_value / fruitimpact_value:,.0f}×"
+        else:
+            ratio = f"{fruitimpact_value / baseline_value:,.0f}×"
         rows.append((task, fruitimpact_value, baseline_name, baseline_value, unit, ratio, note))
-        print(f"{task:<52} {fruitimpact_value:>12.4g} {unit:<12} | {baseline_name:<28} {baseline_value:>12.4g}  "
-              f"speed-up {ratio:,.0f}×  {note}", flush=True)
+        print(f"{task:<56} {fruitimpact_value:>12.4g} {unit:<10} | {baseline_name:<26} {baseline_value:>10.4g}  "
+              f"speed-up {ratio}  {note}", flush=True)
 
     apple = dict(mass=0.115, stiffness=0.8355e6, damping_factor=1.0678, velocity=1.0)
     # ------------------------------------------------------------------ single impacts
@@ -238,7 +243,7 @@ def main(argv=None):
         cli = best_of(lambda: subprocess.run([exe, "simulate"], capture_output=True, check=True), 5)
         py = best_of(lambda: subprocess.run([sys.executable, "-c", "pass"], capture_output=True, check=True), 5)
         record("`fruitimpact simulate` wall time (warm cache)", cli, "bare `python -c pass`", py, "s",
-               "includes interpreter start")
+               "includes interpreter start", compare=False)
 
     if args.markdown:
         with open(args.markdown, "w") as handle:
@@ -246,7 +251,7 @@ def main(argv=None):
                          f"numpy {np.__version__}\n\n")
             handle.write("| task | fruitimpact | unit | baseline | baseline value | ratio | note |\n|---|---|---|---|---|---|---|\n")
             for task, ours_value, base, base_value, unit, ratio, note in rows:
-                handle.write(f"| {task} | {ours_value:.4g} | {unit} | {base} | {base_value:.4g} | {ratio:,.0f}× | {note} |\n")
+                handle.write(f"| {task} | {ours_value:.4g} | {unit} | {base} | {base_value:.4g} | {ratio} | {note} |\n")
 
 
 if __name__ == "__main__":
