@@ -71,7 +71,7 @@ import numba as nb
 import numpy as np
 
 from .forces import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, contact_force
-from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
+from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -688,18 +688,8 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
                 ratio = _ratio_limit(family, params, clamp, v_end)
             if ratio > max_ratio:
                 max_ratio = ratio
-            out[0] = peak_force
-            out[1] = time_to_peak
-            out[2] = t_end
-            out[3] = max_deflection
-            out[4] = time_to_max
-            out[5] = -v_end
-            out[6] = -v_end / velocity
-            out[7] = 0.5 * mass * (velocity * velocity - v_end * v_end)
-            out[8] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
-            out[9] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
-            out[10] = 3.0 * max_ratio / (2.0 * math.pi * radius)
-            out[11] = math.sqrt(radius * max_deflection)
+            fill_characteristics(out, peak_force, time_to_peak, t_end, max_deflection, time_to_max,
+                                 -v_end, velocity, mass, max_ratio, radius)
             return steps
 
         # ---- advance, switching phase where due ----

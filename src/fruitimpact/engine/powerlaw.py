@@ -60,6 +60,27 @@ N_CHARACTERISTICS = len(CHARACTERISTIC_COLUMNS)
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 
 
+@nb.njit(cache=True, error_model="numpy")
+def fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection, time_to_max,
+                         exit_speed, velocity, mass, max_force_ratio, radius):
+    """Write one impact's characteristics into ``out`` (CHARACTERISTIC_COLUMNS order)
+    from what every solver measures: the peak force [N] and its time [s], the
+    contact duration [s], δ_max [m] and its time [s], the rebound speed [m/s],
+    and the largest F/δ [N/m] over the contact (for the Hertz pressure)."""
+    out[0] = peak_force
+    out[1] = time_to_peak
+    out[2] = duration
+    out[3] = max_deflection
+    out[4] = time_to_max
+    out[5] = exit_speed
+    out[6] = exit_speed / velocity
+    out[7] = 0.5 * mass * (velocity - exit_speed) * (velocity + exit_speed)
+    out[8] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
+    out[9] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
+    out[10] = 3.0 * max_force_ratio / (2.0 * math.pi * radius)  # p0 = 3F/(2π a²), a² = R δ
+    out[11] = math.sqrt(radius * max_deflection)
+
+
 @nb.njit(**_JIT)
 def r_func(s):
     """r(s) = (s - ln(1+s))/s², r(0) = 1/2; s > -1."""
@@ -204,23 +225,11 @@ def _characteristics_row(mass, stiffness, n, damping_factor, velocity, radius,
     if n > 1.0:
         zeta_p = stationary_zeta(x, n, r_x, zeta1, n - 1.0)
         delta_p = delta_h * (2.0 * delta_phi(x, zeta_p, r_x)) ** (1.0 / (n + 1.0))
-        force_p = stiffness * delta_p ** n * math.exp(x * zeta_p)
-        max_pressure = 3.0 * force_p / (2.0 * math.pi * radius * delta_p)
+        max_ratio = stiffness * delta_p ** (n - 1.0) * math.exp(x * zeta_p)  # largest F/δ
     else:
-        max_pressure = math.nan
-
-    out[0] = peak_force
-    out[1] = time_to_peak
-    out[2] = duration
-    out[3] = max_deflection
-    out[4] = time_to_max
-    out[5] = restitution * velocity
-    out[6] = restitution
-    out[7] = 0.5 * mass * velocity * velocity * (1.0 - restitution * restitution)
-    out[8] = peak_force / time_to_peak
-    out[9] = peak_force / (time_to_peak * time_to_peak)
-    out[10] = max_pressure
-    out[11] = math.sqrt(radius * max_deflection)
+        max_ratio = math.nan
+    fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection, time_to_max,
+                         restitution * velocity, velocity, mass, max_ratio, radius)
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -584,20 +593,10 @@ def _tabulated_row(mass, stiffness, n, damping_factor, velocity, radius, coeffic
     delta_h = ((n + 1.0) * mass * velocity * velocity / (2.0 * stiffness)) ** (1.0 / (n + 1.0))
     t_h = delta_h / velocity
     force_scale = stiffness * delta_h ** n
-    peak_force = force_scale * f_peak
-    time_to_peak = t_h * t_peak
-    out[0] = peak_force
-    out[1] = time_to_peak
-    out[2] = t_h * t_end
-    out[3] = delta_h * d_max
-    out[4] = t_h * t_max
-    out[5] = e * velocity
-    out[6] = e
-    out[7] = 0.5 * mass * velocity * velocity * (1.0 - e * e)
-    out[8] = peak_force / time_to_peak
-    out[9] = peak_force / (time_to_peak * time_to_peak)
-    out[10] = force_scale / (delta_h * radius) * pressure
-    out[11] = math.sqrt(radius * out[3])
+    # the table's pressure is 3F/(2π R δ) in units of K δ_H^(n-1)/R; back to max F/δ
+    max_ratio = force_scale / delta_h * pressure * 2.0 * math.pi / 3.0
+    fill_characteristics(out, force_scale * f_peak, t_h * t_peak, t_h * t_end, delta_h * d_max, t_h * t_max,
+                         e * velocity, velocity, mass, max_ratio, radius)
 
 
 @nb.njit(parallel=True, **_JIT)

@@ -19,7 +19,7 @@ import numba as nb
 import numpy as np
 
 from .forces import contact_force
-from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
+from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -121,18 +121,8 @@ def rk4_impact(family, params, clamp, mass, velocity, radius, step, max_steps, s
                 d_arr[k] = max(d + theta * (d_new - d), 0.0) if d_new > 0.0 else 0.0
                 v_arr[k] = exit_rate
                 f_arr[k] = 0.0
-            out[0] = peak_force
-            out[1] = time_to_peak
-            out[2] = duration
-            out[3] = max_deflection
-            out[4] = time_to_max
-            out[5] = -exit_rate
-            out[6] = -exit_rate / velocity
-            out[7] = 0.5 * mass * (velocity * velocity - exit_rate * exit_rate)
-            out[8] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
-            out[9] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
-            out[10] = 3.0 * max_ratio / (2.0 * math.pi * radius)
-            out[11] = math.sqrt(radius * max_deflection)
+            fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection, time_to_max,
+                                 -exit_rate, velocity, mass, max_ratio, radius)
             return k + 1
         d = d_new
         v = v_new
