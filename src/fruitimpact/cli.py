@@ -14,6 +14,7 @@ import re
 import sys
 from pathlib import Path
 
+from .quantities import CHARACTERISTICS
 from .units import parse_quantity
 
 PROG = "fruitimpact"
@@ -113,20 +114,6 @@ def _simulate_kwargs(args) -> dict:
 
 
 # --------------------------------------------------------------------------- tables
-TABLE_ROWS = (
-    ("peak force F_max", "peak_force", 1.0, "N"),
-    ("time to peak t_c", "time_to_peak", 1e3, "ms"),
-    ("contact duration T", "contact_duration", 1e3, "ms"),
-    ("max deflection δ_max", "max_deflection", 1e3, "mm"),
-    ("time to max deflection", "time_to_max_deflection", 1e3, "ms"),
-    ("exit velocity", "exit_velocity", 1.0, "m/s"),
-    ("restitution e", "restitution", 1.0, ""),
-    ("absorbed energy", "absorbed_energy", 1e3, "mJ"),
-    ("firmness C = F_max/t_c", "firmness_c", 1e-3, "N/ms"),
-    ("firmness C* = F_max/t_c²", "firmness_c_star", 1e-6, "N/ms²"),
-    ("max contact pressure", "max_pressure", 1e-6, "MPa"),
-    ("contact radius a", "contact_radius", 1e3, "mm"),
-)
 
 
 def format_result_table(result) -> str:
@@ -148,8 +135,9 @@ def format_result_table(result) -> str:
         f"{'characteristic':<28}{'value':>14}  unit",
         f"{'-' * 28}{'-' * 14}  {'-' * 6}",
     ]
-    for label, key, scale, unit in TABLE_ROWS:
-        lines.append(f"{label:<28}{getattr(c, key) * scale:>14.6g}  {unit}")
+    for quantity in list(CHARACTERISTICS.values())[:12]:
+        value = getattr(c, quantity.name) * quantity.scale
+        lines.append(f"{quantity.label:<28}{value:>14.6g}  {quantity.unit}")
     if not math.isnan(c.max_deflection_closed_form):
         lines += ["", "closed-form self-check (first integral of the force law):",
                   f"  δ_max = {c.max_deflection_closed_form * 1e3:.9g} mm "
