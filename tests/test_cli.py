@@ -490,3 +490,11 @@ def test_rk4_step_longer_than_contact_is_refused(capsys):
     status, out, err = run(capsys, "--method", "rk4", "--step", "10ms", "--json")
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and "--step" in err and "at least 20 steps" in err
+
+
+def test_plot_overlays_other_models(capsys, tmp_path):
+    path = tmp_path / "overlay.png"
+    status, out, err = run(capsys, "--plot", str(path), "--overlay", "chen:paper", "--overlay", "hunt-crossley:paper:rk4")
+    assert status == 0 and path.stat().st_size > 10_000
+    status, out, err = run(capsys, "--plot", str(path), "--overlay", "chen:bogus")
+    assert status == 2 and "--overlay" in err and err.count("\n") == 1

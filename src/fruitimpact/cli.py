@@ -171,6 +171,24 @@ def dump_json(obj) -> str:
 
 
 # --------------------------------------------------------------------------- commands
+def _overlays(args) -> list[dict]:
+    """--overlay MODEL[:CALIBRATION[:METHOD]] → simulate() overrides, checked against the registries."""
+    from .models import CALIBRATIONS, DAMPING_LAWS
+    from .solvers import SOLVERS
+
+    overlays = []
+    for text in args.overlay or ():
+        parts = text.split(":")
+        names = dict(zip(("model", "calibration", "method"), parts))
+        for key, registry in (("model", DAMPING_LAWS), ("calibration", CALIBRATIONS), ("method", SOLVERS)):
+            if key in names and names[key] not in registry:
+                raise UsageError(f"argument --overlay: {key} must be one of {', '.join(registry)}; got {names[key]!r}")
+        if len(parts) > 3 or not parts[0]:
+            raise UsageError(f"argument --overlay: expected MODEL[:CALIBRATION[:METHOD]]; got {text!r}")
+        overlays.append(names)
+    return overlays
+
+
 def cmd_simulate(args) -> int:
     from .impact import simulate
 
@@ -181,7 +199,8 @@ def cmd_simulate(args) -> int:
     if args.plot:
         from .plotting import impact_figure, save_figure
 
-        save_figure(impact_figure(result, title="fruitimpact: impact of the fruit on the surface"), args.plot)
+        results = [result] + [_library_call(simulate, **{**kwargs, **overlay}) for overlay in _overlays(args)]
+        save_figure(impact_figure(results, title="fruitimpact: impact of the fruit on the surface"), args.plot)
     if args.json:
         print(dump_json(result.to_dict()))
     else:
@@ -584,6 +603,9 @@ def build_parser() -> argparse.ArgumentParser:
     out.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of a table")
     out.add_argument("--csv", metavar="FILE", help="write the curves t, δ, δ̇, F as CSV")
     out.add_argument("--plot", metavar="FILE", help="write the four-panel figure (PNG/SVG/PDF by extension)")
+    out.add_argument("--overlay", action="append", metavar="MODEL[:CALIBRATION[:METHOD]]",
+                     help="also draw this model (and calibration, method) on --plot; repeatable, "
+                          "e.g. --overlay chen:paper --overlay hunt-crossley:paper:rk4")
     sim.set_defaults(func=cmd_simulate)
 
     pap = sub.add_parser("paper", help="reproduce the founding paper's Table 1 and worked example")
