@@ -372,3 +372,13 @@ def test_batch_of_an_empty_file_writes_the_columns(tmp_path, capsys):
     assert "0 rows: 0 ok, 0 invalid, 0 failed" in ok(capsys, "batch", tmp_path / "in.csv", "-o", tmp_path / "o.parquet")
     result = read(tmp_path / "o.parquet")
     assert len(result) == 0 and list(result.columns[:2]) == ["row", "mass"] and "peak_force" in result
+
+
+def test_population_with_every_input_at_its_default(capsys):
+    # no distribution given: every member is the default apple, and the row count holds
+    # even past the percentile sample size (regression: 0 rows / crash)
+    report = json.loads(ok(capsys, "population", "-n", 3000, "--chunk-size", 1000, "--sample-size", 500, "--json"))
+    assert report["rows"] == 3000 and report["ok"] == 3000
+    default = simulate().characteristics.peak_force
+    stats = report["statistics"]["peak_force"]
+    assert stats["min"] == pytest.approx(default, rel=1e-12) and stats["max"] == pytest.approx(default, rel=1e-12)

@@ -53,6 +53,7 @@ def _numeric_column(frame, name, dimension, default, rows, messages):
         return np.full(rows, np.nan if default is None else default)
     column = frame[name]
     values = np.asarray(column.to_numpy() if hasattr(column, "to_numpy") else column)
+    unreadable = np.zeros(rows, dtype=bool)
     if values.dtype.kind in "fiu":
         out = values.astype(float)
     else:
@@ -65,12 +66,13 @@ def _numeric_column(frame, name, dimension, default, rows, messages):
                 out[i] = parse_quantity(cell, dimension)
             except ValueError as exc:
                 out[i] = np.nan
+                unreadable[i] = True
                 messages[i] = messages[i] or f"{name}: {exc}"
             else:
                 if not math.isfinite(out[i]):
                     messages[i] = messages[i] or f"{name} must be a finite number; got {cell!r}"
     if default is not None:  # an empty cell takes the default, as an omitted option does
-        out = np.where(np.isnan(out), default, out)
+        out = np.where(np.isnan(out) & ~unreadable, default, out)
     return out
 
 
@@ -128,10 +130,11 @@ def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noq
                                   ("method", SOLVERS, "method")):
         _require(~np.isin(text[name], list(registry)), f"{label} must be one of {', '.join(registry)}", messages)
 
-    velocity = np.where(np.isnan(values["drop_height"]),
-                        np.where(np.isnan(values["velocity"]), JONATHAN_VELOCITY, values["velocity"]),
-                        np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])))
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"):  # a given velocity wins, so a conflicting row records what was given
+        velocity = np.where(~np.isnan(values["velocity"]), values["velocity"],
+                            np.where(np.isnan(values["drop_height"]), JONATHAN_VELOCITY,
+                                     np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"]))))
+    with np.errstate(invalid="ignore", divide="ignore"):
         alpha = values["alpha"]
         bad_alpha = ~np.isnan(alpha) & ~((alpha >= 0) & (alpha < 1.0 / velocity))
         _require(bad_alpha, "alpha must be in [0, 1/V_i) s/m (so that k = 1 - alpha*V_i is in (0, 1])", messages)

@@ -116,6 +116,12 @@ def _simulate_kwargs(args) -> dict:
 # --------------------------------------------------------------------------- tables
 
 
+def _law_line(law) -> str:
+    (k_symbol, k_unit), (d_symbol, d_unit), c_unit = law.units
+    return (f"contact    {k_symbol} = {law.stiffness:.5g} {k_unit}, {d_symbol} = {law.damping:.5g} {d_unit}"
+            f" (damping factor {d_symbol}/{k_symbol} = {law.damping_factor:.5g} {c_unit})")
+
+
 def format_result_table(result) -> str:
     """A readable table of one result's inputs and characteristics."""
     inputs = result.inputs
@@ -129,8 +135,7 @@ def format_result_table(result) -> str:
         + (f", target k = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else ""),
         f"law        {inputs.model}, calibration {inputs.calibration}, method {inputs.method}"
         + (f" (step {inputs.step:g} s)" if inputs.method == "rk4" else ""),
-        f"contact    k_c = {result.law.stiffness / 1e6:.5g}e6 N/m^1.5, λ = {result.law.damping / 1e6:.5g}e6 N·s/m^2.5"
-        f" (c = λ/k_c = {result.law.damping_factor:.5g} s/m)",
+        _law_line(result.law),
         "",
         f"{'characteristic':<28}{'value':>14}  unit",
         f"{'-' * 28}{'-' * 14}  {'-' * 6}",

@@ -104,8 +104,12 @@ def restitution_figure(table, velocity=None):
     velocity = velocity if velocity is not None else sorted(table["velocity"].unique())[len(table["velocity"].unique()) // 2]
     fig, ax = plt.subplots(figsize=(7.5, 6), constrained_layout=True)
     subset = table[np.isclose(table["velocity"], velocity)]
-    for name, rows in subset.groupby("law", sort=False):
-        ax.plot(rows["target"], rows["achieved"], marker="o", ms=3, label=name)
+    colours = plt.get_cmap("tab20").colors
+    for i, (name, rows) in enumerate(subset.groupby("law", sort=False)):
+        # a colour per law, a line style per family: 18 laws stay distinguishable
+        style = "-" if DAMPING_LAWS[name].family == forces.POWER_LAW else "--"
+        ax.plot(rows["target"], rows["achieved"], style, marker="o", ms=3, color=colours[i % len(colours)],
+                label=name)
     ax.plot([0, 1], [0, 1], color="0.3", lw=1, ls="--", label="achieved = requested")
     ax.set(xlabel="requested restitution e [-]", ylabel="achieved restitution e [-]", xlim=(0, 1), ylim=(0, 1),
            title=f"Published calibrations at V_i = {velocity:g} m/s")

@@ -97,6 +97,15 @@ class Surface:
 RIGID_PLANE = Surface()
 
 
+#: Per force family: (stiffness symbol, unit), (damping symbol, unit), damping-factor unit.
+FAMILY_UNITS = {
+    forces.POWER_LAW: (("k_c", "N/m^1.5"), ("λ", "N·s/m^2.5"), "s/m"),
+    forces.KELVIN_VOIGT: (("k", "N/m"), ("b", "N·s/m"), "s"),
+    forces.KUWABARA_KONO: (("K", "N/m^1.5"), ("K·B", "N·s/m^1.5"), "s"),
+    forces.TSUJI: (("K", "N/m^1.5"), ("η", "N·s/m^1.25"), "s·m^0.25"),
+}
+
+
 @dataclass(frozen=True)
 class ContactLaw:
     """The resolved force law of one impact.
@@ -128,6 +137,11 @@ class ContactLaw:
         """Coefficient of the rate term: λ [N·s/m^2.5] (F_d = λ δ^1.5 δ̇; the paper's
         λ1, A or β), b [N·s/m] (Kelvin–Voigt), K·B (Kuwabara–Kono), η (Tsuji)."""
         return self.damping_factor * self.stiffness
+
+    @property
+    def units(self) -> tuple:
+        """((stiffness symbol, unit), (damping symbol, unit), damping-factor unit) of this family."""
+        return FAMILY_UNITS[self.family]
 
     def params(self) -> np.ndarray:
         """Parameter vector for the compiled force of ``family``."""
@@ -242,11 +256,13 @@ class ImpactResult:
             stiffness=self.law.stiffness,
             damping=self.law.damping,
             damping_factor=self.law.damping_factor,
+            stiffness_unit=self.law.units[0][1],
+            damping_unit=self.law.units[1][1],
             mass=fruit["mass"], diameter=fruit["diameter"], modulus=fruit["modulus"],
             poisson=fruit["poisson"], velocity=inputs.velocity, drop_height=inputs.drop_height,
             target_restitution=inputs.target_restitution, alpha=inputs.alpha,
             model=inputs.model, calibration=inputs.calibration, method=inputs.method,
-            step=inputs.step if inputs.method == "rk4" else None,
+            step=inputs.step,
             success=self.success, message=self.message,
         )
         flat["inputs"] = {"fruit": fruit, "surface": asdict(inputs.surface),

@@ -325,6 +325,8 @@ class PopulationSource:
             yield index, None
 
     def _stream(self, start: int, stop: int, stream: int, draw) -> np.ndarray:
+        if stop <= start:
+            return np.empty(0)
         blocks = range(start // BLOCK_ROWS, (stop - 1) // BLOCK_ROWS + 1)
         values = np.concatenate([draw(_generator(self.seed, b, stream), BLOCK_ROWS) for b in blocks])
         offset = blocks[0] * BLOCK_ROWS
@@ -342,6 +344,8 @@ class PopulationSource:
                 columns[name] = self._stream(start, stop, order.index(name), dist.draw)
         for name, value in self.text:
             columns[name] = np.full(stop - start, value, dtype=object)
+        # with every input at its default there would be no column to carry the row count
+        columns.setdefault("model", np.full(stop - start, TEXT_COLUMNS["model"], dtype=object))
         return columns
 
     def keys(self, start: int, stop: int) -> np.ndarray:
@@ -535,7 +539,10 @@ class DaskEngine:
                                    dashboard_address=":0", silence_logs=logging.ERROR)
             client = Client(cluster)
         else:
-            client = Client(self.scheduler)
+            try:
+                client = Client(self.scheduler, timeout="10s")
+            except (OSError, TimeoutError) as exc:
+                raise RunError(f"argument --scheduler: cannot connect to {self.scheduler!r} ({exc})") from None
         try:
             slots = max(1, sum(client.nthreads().values()))
             shared = client.scatter(plan, broadcast=True)
