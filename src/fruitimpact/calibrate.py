@@ -53,44 +53,52 @@ def achieved_restitution(law, damping_factor, mass, stiffness, velocity):
     return out[:, RESTITUTION]
 
 
+_GROUP_TABLES: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _group_table(law):
+    """(g, e): the restitution of ``law`` on a grid of its dimensionless damping group
+    g, from a reference impact (m = K = v0 = 1), since e depends on g alone.  Built
+    once per law (about 1400 integrations); never separating counts as e = 0."""
+    table = _GROUP_TABLES.get(law.name)
+    if table is None:
+        group = np.concatenate([[0.0], np.geomspace(1e-5, 1e3, 1400)])
+        one = np.ones_like(group)
+        e = achieved_restitution(law, law.from_group(group, one, one, one), one, one, one)
+        table = _GROUP_TABLES[law.name] = (group, np.nan_to_num(e, nan=0.0))
+    return table
+
+
 def _invert_numerically(law, target, mass, stiffness, velocity):
-    """Damping factor giving restitution ``target``: Illinois iteration on the
-    dimensionless group g (e decreases with g), bracket grown from the
-    published value."""
-    group0 = law.group(law.published_damping_factor(target, mass, stiffness, velocity), mass, stiffness, velocity)
-    group0 = np.where(group0 > 0, group0, 1e-3)
-
-    def residual(group):
-        factor = law.from_group(group, mass, stiffness, velocity)
-        return achieved_restitution(law, factor, mass, stiffness, velocity) - target
-
-    lo = np.zeros_like(group0)
-    f_lo = 1.0 - target  # e = 1 without damping
-    hi = group0.copy()
-    f_hi = residual(hi)
-    for _ in range(60):  # grow hi until e(hi) < target (never separating counts as e = 0)
-        grow = ~(f_hi < 0)
-        if not grow.any():
-            break
-        lo = np.where(grow, hi, lo)
-        f_lo = np.where(grow, f_hi, f_lo)
-        hi = np.where(grow, hi * 2.0, hi)
-        f_hi = np.where(grow, np.nan_to_num(residual(hi), nan=-target), f_hi)
+    """Damping factor giving restitution ``target``: the law's table of e(g) brackets
+    the dimensionless group g between two neighbouring grid points, then an
+    Illinois iteration on each row's own impact (only rows not yet converged)
+    finds g to EXACT_TOLERANCE in e."""
+    group_grid, e_grid = _group_table(law)
+    index = np.clip(np.searchsorted(-e_grid, -target, side="left"), 1, len(e_grid) - 1)
+    lo, hi = group_grid[index - 1], group_grid[index]
+    f_lo, f_hi = e_grid[index - 1] - target, e_grid[index] - target
+    group = hi.copy()
     side = np.zeros_like(hi)
-    group = hi
-    for _ in range(100):
-        group = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        f = np.nan_to_num(residual(group), nan=-target)
-        done = np.abs(f) <= EXACT_TOLERANCE * target
-        if done.all():
-            break
-        positive = f > 0  # e above target: root lies between group and hi
-        lo, f_lo = np.where(positive, group, lo), np.where(positive, f, f_lo)
-        hi, f_hi = np.where(positive, hi, group), np.where(positive, f_hi, f)
+    active = np.arange(len(target))
+    for _ in range(60):
+        a = active
+        trial = hi[a] - f_hi[a] * (hi[a] - lo[a]) / (f_hi[a] - f_lo[a])
+        trial = np.where(np.isfinite(trial) & (trial > lo[a]) & (trial < hi[a]), trial, 0.5 * (lo[a] + hi[a]))
+        factor = law.from_group(trial, mass[a], stiffness[a], velocity[a])
+        f = np.nan_to_num(achieved_restitution(law, factor, mass[a], stiffness[a], velocity[a]) - target[a],
+                          nan=-target[a])
+        group[a] = trial
+        positive = f > 0  # e above target: the root lies between trial and hi
+        lo[a] = np.where(positive, trial, lo[a])
+        hi[a] = np.where(positive, hi[a], trial)
         # Illinois: halve the retained end's value when the same side is kept twice
-        f_hi = np.where(positive & (side > 0), f_hi / 2.0, f_hi)
-        f_lo = np.where(~positive & (side < 0), f_lo / 2.0, f_lo)
-        side = np.where(positive, 1.0, -1.0)
+        f_lo[a] = np.where(positive, f, np.where(side[a] < 0, f_lo[a] / 2.0, f_lo[a]))
+        f_hi[a] = np.where(positive, np.where(side[a] > 0, f_hi[a] / 2.0, f_hi[a]), f)
+        side[a] = np.where(positive, 1.0, -1.0)
+        active = a[np.abs(f) > EXACT_TOLERANCE * target[a]]
+        if active.size == 0:
+            break
     return law.from_group(group, mass, stiffness, velocity)
 
 
