@@ -21,9 +21,9 @@ from .calibrate import damping_factor as calibrated_damping_factor
 from .calibrate import law_params
 from .constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY, STANDARD_GRAVITY
 from .engine import forces
-from .engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, powerlaw_characteristics
+from .engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
 from .models import CALIBRATIONS, DAMPING_LAWS
-from .solvers import ADAPTIVE_RTOL, RK4_MAX_STEPS, SOLVERS
+from .solvers import SOLVERS, judge_batch
 from .units import parse_quantity
 
 #: Input columns, their dimension and default (None: optional, NaN when absent).
@@ -169,23 +169,9 @@ def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noq
         m, k, v, e, r = mass[idx], stiffness[idx], velocity[idx], target[idx], radius[idx]
         factor[idx] = calibrated_damping_factor(law, calibration, e, m, k, v)
         law_stiffness[idx] = law.linear_stiffness(m, k, v)
-        params = law_params(law.family, law_stiffness[idx], factor[idx])
-        if method == "rk4":
-            from .engine.rk4 import rk4_batch
-
-            result = np.empty((len(idx), N_CHARACTERISTICS))
-            rk4_batch(np.full(len(idx), law.family, dtype=np.int64), params, np.full(len(idx), law.clamp), m, v, r,
-                      values["step"][idx], RK4_MAX_STEPS, result)
-        elif law.family == forces.POWER_LAW:
-            result = powerlaw_characteristics(m, law_stiffness[idx], factor[idx], v, r, tabulated=tabulated)
-        else:
-            from .engine.adaptive import adaptive_characteristics
-
-            result = adaptive_characteristics(np.full(len(idx), law.family), params, np.full(len(idx), law.clamp),
-                                              m, v, r, ADAPTIVE_RTOL)
-        out[idx] = result
-    out[np.isinf(out[:, 10]), 10] = np.nan  # unbounded Hertz pressure at first touch: undefined (solvers._judge)
-    computed = valid & ~np.all(np.isfinite(out[:, [0, 2, 3, 6]]), axis=1)  # as solvers._judge
+        out[idx] = SOLVERS[method].batch(law.family, law.clamp, law_stiffness[idx], factor[idx], m, v, r,
+                                         values["step"][idx], tabulated)
+    computed = valid & ~judge_batch(out)
     status[computed] = "failed"
     messages[computed] = "solver did not reach separation (non-finite characteristics)"
     messages[status == "ok"] = "ok"

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .engine import forces
-from .engine.powerlaw import (N_CHARACTERISTICS, powerlaw_curves, powerlaw_single, r_func,
-                              restitution_of_x)
+from .engine.powerlaw import (N_CHARACTERISTICS, powerlaw_characteristics, powerlaw_curves, powerlaw_single,
+                              r_func, restitution_of_x)
 from .engine.rk4 import rk4_impact
 
 #: Safety limit on RK4 steps for one impact.
@@ -116,18 +116,50 @@ def _rk4_curves(law, mass, velocity, step, points):
     return t[:count].copy(), d[:count].copy(), v[:count].copy(), f[:count].copy()
 
 
+def judge_batch(out: np.ndarray) -> np.ndarray:
+    """Rows of a characteristics array that completed (as ``_judge``); an unbounded
+    Hertz pressure at first touch is set to NaN in place."""
+    out[np.isinf(out[:, 10]), 10] = np.nan
+    return np.all(np.isfinite(out[:, _ESSENTIAL]), axis=1)
+
+
+def _accurate_batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
+    if family == forces.POWER_LAW:
+        return powerlaw_characteristics(mass, stiffness, damping_factor, velocity, radius, tabulated=tabulated)
+    from .calibrate import law_params
+    from .engine.adaptive import adaptive_characteristics
+
+    rows = len(mass)
+    return adaptive_characteristics(np.full(rows, family), law_params(family, stiffness, damping_factor),
+                                    np.full(rows, clamp), mass, velocity, radius, ADAPTIVE_RTOL)
+
+
+def _rk4_batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
+    from .calibrate import law_params
+    from .engine.rk4 import rk4_batch
+
+    rows = len(mass)
+    out = np.empty((rows, N_CHARACTERISTICS))
+    rk4_batch(np.full(rows, family, dtype=np.int64), law_params(family, stiffness, damping_factor),
+              np.full(rows, clamp), mass, velocity, radius, np.broadcast_to(step, (rows,)).astype(float),
+              RK4_MAX_STEPS, out)
+    return out
+
+
 @dataclass(frozen=True)
 class Solver:
-    """A way to integrate one impact.
+    """A way to integrate impacts, one or many.
 
     characteristics(law, mass, velocity, radius, step) -> (values, success, message)
     curves(law, mass, velocity, step, points) -> (t, δ, δ̇, F)
+    batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated) -> (rows, 12)
     """
 
     name: str
     description: str
     characteristics: Callable
     curves: Callable
+    batch: Callable
     closed_forms: Callable = closed_forms
 
 
@@ -138,6 +170,7 @@ SOLVERS: dict[str, Solver] = {
                      "contact time; curves by exact inversion of t(δ̇) (agrees with closed forms to ~1e-12)"),
         characteristics=_accurate_characteristics,
         curves=_accurate_curves,
+        batch=_accurate_batch,
     ),
     "rk4": Solver(
         name="rk4",
@@ -145,6 +178,7 @@ SOLVERS: dict[str, Solver] = {
                      "end of contact is interpolated inside the last step"),
         characteristics=_rk4_characteristics,
         curves=_rk4_curves,
+        batch=_rk4_batch,
     ),
 }
 
