@@ -60,6 +60,15 @@ KNOWN = [
     ("66N", "force", 66.0),
     ("1.5kN", "force", 1500.0),
     ("20mN", "force", 0.02),
+    # firmness C [N/s] and C* [N/s²] (eqs 1, 2)
+    ("37N/ms", "firmness", 37000.0),
+    ("3.7e4N/s", "firmness", 37000.0),
+    ("20N/ms^2", "firmness_star", 2.0e7),
+    ("20N/ms2", "firmness_star", 2.0e7),
+    ("20N/ms²", "firmness_star", 2.0e7),
+    ("2e7N/s^2", "firmness_star", 2.0e7),
+    ("2e7N/s2", "firmness_star", 2.0e7),
+    ("2e7N/s²", "firmness_star", 2.0e7),
     # energy [J]
     ("2J", "energy", 2.0),
     ("38mJ", "energy", 0.038),

@@ -23,8 +23,9 @@ from .constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY, 
 from .engine import forces
 from .engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
 from .models import CALIBRATIONS, DAMPING_LAWS
-from .solvers import SOLVERS, judge_batch
+from .solvers import SOLVERS, judge_batch, max_rk4_step
 from .units import parse_quantity
+from .validation import positive_message, range_message
 
 #: Input columns, their dimension and default (None: optional, NaN when absent).
 INPUT_COLUMNS = {
@@ -114,14 +115,14 @@ def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noq
         bad = ~(np.isfinite(value) & (value > 0))
         if optional:
             bad &= ~np.isnan(value)
-        _require(bad, f"{name} must be a finite number > 0 {unit}", messages)
+        _require(bad, positive_message(name, unit), messages)
 
     for name, unit in (("mass", "kg"), ("diameter", "m"), ("modulus", "Pa"), ("step", "s")):
         positive(name, unit, optional=False)
     for name, unit in (("stiffness", "N/m^1.5"), ("velocity", "m/s"), ("drop_height", "m")):
         positive(name, unit, optional=True)
     poisson = values["poisson"]
-    _require(~((poisson > -1) & (poisson < 0.5)), "poisson must be in (-1, 0.5)", messages)
+    _require(~((poisson > -1) & (poisson < 0.5)), range_message("poisson", -1, 0.5), messages)
     _require(~np.isnan(values["velocity"]) & ~np.isnan(values["drop_height"]),
              "give either velocity or drop_height, not both", messages)
     _require(~np.isnan(values["restitution"]) & ~np.isnan(values["alpha"]),
@@ -140,15 +141,14 @@ def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noq
         _require(bad_alpha, "alpha must be in [0, 1/V_i) s/m (so that k = 1 - alpha*V_i is in (0, 1])", messages)
         target = np.where(np.isnan(alpha), np.where(np.isnan(values["restitution"]), JONATHAN_RESTITUTION,
                                                     values["restitution"]), 1.0 - alpha * velocity)
-        _require(np.isnan(alpha) & ~((target > 0) & (target <= 1)), "restitution must be in (0, 1]", messages)
+        _require(np.isnan(alpha) & ~((target > 0) & (target <= 1)),
+                 range_message("restitution", 0, 1, high_inclusive=True), messages)
         hertz = contact.rigid_plane_stiffness(values["modulus"], poisson, values["diameter"])
     stiffness = np.where(np.isnan(values["stiffness"]), hertz, values["stiffness"])
     radius = values["diameter"] / 2.0
     mass = values["mass"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        hertz_duration = contact.hertz_contact_duration(mass, stiffness, velocity)
     rk4 = text["method"] == "rk4"
-    _require(rk4 & ~(values["step"] <= hertz_duration / 20.0),
+    _require(rk4 & ~(values["step"] <= max_rk4_step(mass, stiffness, velocity)),
              "step must be at most 1/20 of the contact duration for rk4 (at least 20 steps per contact)", messages)
 
     valid = messages == ""

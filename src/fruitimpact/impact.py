@@ -25,7 +25,7 @@ from .constants import (JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY,
                         STANDARD_GRAVITY)
 from .engine import forces
 from .models import get_calibration, get_law
-from .solvers import get_solver
+from .solvers import get_solver, max_rk4_step
 from .validation import check_exclusive, check_positive, check_range
 
 
@@ -321,11 +321,8 @@ def prepare(fruit: Fruit | None = None, *, velocity=None, drop_height=None, rest
         target = restitution
     stiffness, radius = resolve_stiffness(fruit, surface)
     if method == "rk4":
-        # at least 20 steps per contact: the undamped Hertz duration is a lower bound of T
-        # for the laws here (damping lengthens the contact)
-        longest = float(contact.hertz_contact_duration(fruit.mass, stiffness, velocity)) / 20.0
-        step = check_range("step", step, 0.0, longest, high_inclusive=True,
-                           unit="s for this impact (at least 20 steps per contact)")
+        step = check_range("step", step, 0.0, float(max_rk4_step(fruit.mass, stiffness, velocity)),
+                           high_inclusive=True, unit="s for this impact (at least 20 steps per contact)")
     factor = float(calibrated_damping_factor(law, cal.name, target, fruit.mass, stiffness, velocity))
     inputs = ImpactInputs(fruit=fruit, surface=surface, velocity=velocity, drop_height=drop_height,
                           restitution=restitution, alpha=alpha, model=law.name, calibration=cal.name,

@@ -5,7 +5,6 @@ One table for every place that shows a characteristic or an input to a person
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 from .units import parse_quantity
@@ -20,8 +19,7 @@ class Quantity:
     unit: str  # display unit
     scale: float  # display value = SI value * scale
     si_unit: str
-    dimension: str | None = None  # a key of fruitimpact.units.UNITS, for parsing values
-    extra_units: tuple = ()  # (unit, factor to SI) where no dimension fits
+    dimension: str  # a key of fruitimpact.units.UNITS, for parsing values
 
     @property
     def axis_label(self) -> str:
@@ -29,18 +27,11 @@ class Quantity:
 
     def parse(self, text: str) -> float:
         """A value of this quantity (plain number = SI, or with a unit) → SI."""
-        if self.dimension is not None:
-            return parse_quantity(text, self.dimension)
-        match = re.match(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$", text)
-        units = dict(self.extra_units)
-        if match is None or (match.group(2) and match.group(2) not in units):
-            raise ValueError(f"cannot read {text!r} as a value of {self.name} "
-                             f"(units allowed: {', '.join(units)}; a plain number is {self.si_unit})")
-        return float(match.group(1)) * units.get(match.group(2), 1.0)
+        return parse_quantity(text, self.dimension)
 
 
-def _q(name, label, unit, scale, si_unit, dimension=None, extra_units=()):
-    return name, Quantity(name, label, unit, scale, si_unit, dimension, extra_units)
+def _q(name, label, unit, scale, si_unit, dimension):
+    return name, Quantity(name, label, unit, scale, si_unit, dimension)
 
 
 #: Characteristics (and law columns) of the output: what can be summarised, plotted, thresholded.
@@ -53,9 +44,8 @@ CHARACTERISTICS = dict((
     _q("exit_velocity", "exit velocity", "m/s", 1.0, "m/s", "velocity"),
     _q("restitution", "restitution e", "", 1.0, "", "dimensionless"),
     _q("absorbed_energy", "absorbed energy", "mJ", 1e3, "J", "energy"),
-    _q("firmness_c", "firmness C = F_max/t_c", "N/ms", 1e-3, "N/s", None, (("N/s", 1.0), ("N/ms", 1e3))),
-    _q("firmness_c_star", "firmness C* = F_max/t_c²", "N/ms²", 1e-6, "N/s²", None,
-       (("N/s^2", 1.0), ("N/s2", 1.0), ("N/s²", 1.0), ("N/ms^2", 1e6), ("N/ms2", 1e6), ("N/ms²", 1e6))),
+    _q("firmness_c", "firmness C = F_max/t_c", "N/ms", 1e-3, "N/s", "firmness"),
+    _q("firmness_c_star", "firmness C* = F_max/t_c²", "N/ms²", 1e-6, "N/s²", "firmness_star"),
     _q("max_pressure", "max contact pressure p_0", "MPa", 1e-6, "Pa", "modulus"),
     _q("contact_radius", "contact radius a", "mm", 1e3, "m", "length"),
     _q("law_stiffness", "contact stiffness k_c", "N/m^1.5", 1.0, "N/m^1.5", "stiffness"),

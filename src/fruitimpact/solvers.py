@@ -21,6 +21,17 @@ from .engine.rk4 import rk4_impact
 
 #: Safety limit on RK4 steps for one impact.
 RK4_MAX_STEPS = 2_000_000
+#: Fewest RK4 steps per contact accepted (the step may be at most T_Hertz / this).
+RK4_MIN_STEPS_PER_CONTACT = 20
+
+
+def max_rk4_step(mass, stiffness, velocity):
+    """Coarsest accepted RK4 step [s]: 1/20 of the undamped Hertz contact duration,
+    a lower bound of T for the laws here (damping lengthens the contact)."""
+    from .contact import hertz_contact_duration
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return hertz_contact_duration(mass, stiffness, velocity) / RK4_MIN_STEPS_PER_CONTACT
 
 
 def closed_forms(law, mass: float, velocity: float) -> tuple[float, float]:

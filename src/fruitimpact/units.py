@@ -22,6 +22,8 @@ UNITS: dict[str, dict[str, float]] = {
     "alpha": {"s/m": 1.0},
     "damping": {"Ns/m^2.5": 1.0, "N*s/m^2.5": 1.0, "N.s/m^2.5": 1.0},
     "force": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    "firmness": {"N/s": 1.0, "N/ms": 1e3},
+    "firmness_star": {"N/s^2": 1.0, "N/s2": 1.0, "N/s²": 1.0, "N/ms^2": 1e6, "N/ms2": 1e6, "N/ms²": 1e6},
     "energy": {"J": 1.0, "mJ": 1e-3},
     "frequency": {"Hz": 1.0, "kHz": 1e3},
     "dimensionless": {"": 1.0, "%": 1e-2},
@@ -31,6 +33,7 @@ UNITS: dict[str, dict[str, float]] = {
 SI_UNIT = {
     "mass": "kg", "length": "m", "modulus": "Pa", "velocity": "m/s", "time": "s",
     "stiffness": "N/m^1.5", "alpha": "s/m", "damping": "N·s/m^2.5", "force": "N", "energy": "J",
+    "firmness": "N/s", "firmness_star": "N/s²",
     "frequency": "Hz", "dimensionless": "",
 }
 
