@@ -461,6 +461,16 @@ def _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, 
 
 
 @nb.njit(**_JIT)
+def _locate(kind, theta_end, f_end, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
+    """(t, δ, δ̇) where event ``kind`` (2: dF/dt, 3: d(F/δ)/dt) vanishes inside the
+    last step, from its value at the step start and ``f_end`` at ``theta_end``."""
+    f_start = _event(kind, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+    theta = _root(kind, 0.0, f_start, theta_end, f_end, 0.0, mode, q, family, params, clamp, inv_mass,
+                  x, h, y1, y2, c1, c2)
+    return _state(mode, q, theta, x, h, y1, y2, c1, c2)
+
+
+@nb.njit(**_JIT)
 def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
     """θ in [lo, hi] where event ``kind`` changes sign (f_lo, f_hi of
     opposite signs or zero), by the Illinois variant of regula falsi,
@@ -629,28 +639,21 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             time_to_max, max_deflection, _v = _state(mode, q, theta, x, h, y1, y2, c1, c2)
 
         force_end, g_end, h_end = _rates(family, params, clamp, inv_mass, d_end, v_end)
-        if g_old > 0.0 and g_end < 0.0:  # local maximum of F
-            if not dense_ready:
-                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
-                             k1, k2, c1, c2)
-                dense_ready = True
-            g_start = _event(2, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
-            theta = _root(2, 0.0, g_start, theta_end, g_end, 0.0, mode, q, family, params, clamp, inv_mass,
-                          x, h, y1, y2, c1, c2)
-            tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
+        force_peak = g_old > 0.0 and g_end < 0.0  # local maximum of F in this step
+        ratio_peak = h_old > 0.0 and h_end < 0.0  # local maximum of F/δ in this step
+        if (force_peak or ratio_peak) and not dense_ready:
+            _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
+            dense_ready = True
+        if force_peak:
+            tt, dd, vv = _locate(2, theta_end, g_end, mode, q, family, params, clamp, inv_mass, x, h,
+                                 y1, y2, c1, c2)
             force = contact_force(family, params, dd, vv, clamp)
             if force > peak_force:
                 peak_force = force
                 time_to_peak = tt
-        if h_old > 0.0 and h_end < 0.0:  # local maximum of F/δ
-            if not dense_ready:
-                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
-                             k1, k2, c1, c2)
-                dense_ready = True
-            h_start = _event(3, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
-            theta = _root(3, 0.0, h_start, theta_end, h_end, 0.0, mode, q, family, params, clamp, inv_mass,
-                          x, h, y1, y2, c1, c2)
-            tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
+        if ratio_peak:
+            tt, dd, vv = _locate(3, theta_end, h_end, mode, q, family, params, clamp, inv_mass, x, h,
+                                 y1, y2, c1, c2)
             if dd > 0.0:
                 ratio = contact_force(family, params, dd, vv, clamp) / dd
                 if ratio > max_ratio:
