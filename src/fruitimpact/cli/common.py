@@ -1,0 +1,221 @@
+"""Shared pieces of the command line: the one-line error, option parsing with
+units, JSON output, and the impact options every command shares.
+
+Bad input is answered with one line on stderr naming the argument and its
+allowed range, exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import sys
+
+from ..units import parse_quantity
+
+PROG = "fruitimpact"
+
+
+class UsageError(Exception):
+    """Bad command-line input: printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, no usage block
+        raise UsageError(message)
+
+
+# (option, dimension, help) of the impact inputs; option names are a contract.
+IMPACT_OPTIONS = (
+    ("--mass", "mass", "fruit mass M (e.g. 115g) [kg]"),
+    ("--diameter", "length", "fruit diameter d (e.g. 65mm) [m]"),
+    ("--modulus", "modulus", "Young's modulus E of the flesh (e.g. 3MPa) [Pa]"),
+    ("--poisson", "dimensionless", "Poisson's ratio ν, in (-1, 0.5)"),
+    ("--stiffness", "stiffness", "contact stiffness k_c [N/m^1.5]; overrides E, ν, d (eq 9)"),
+    ("--velocity", "velocity", "impact velocity V_i (e.g. 1m/s) [m/s]"),
+    ("--drop-height", "length", "drop height h instead of --velocity (e.g. 30cm) [m]"),
+    ("--restitution", "dimensionless", "restitution coefficient k, in (0, 1]"),
+    ("--alpha", "alpha", "Hunt-Crossley α instead of k, k = 1 - α V_i (eq 6) [s/m]"),
+)
+
+
+def _dest(option: str) -> str:
+    return option.lstrip("-").replace("-", "_")
+
+
+def _quantities(args, options=IMPACT_OPTIONS) -> dict:
+    """Parse the unit-bearing options; a bad one raises UsageError naming it."""
+    values = {}
+    for option, dimension, _ in options:
+        text = getattr(args, _dest(option), None)
+        if text is None:
+            continue
+        try:
+            values[_dest(option)] = parse_quantity(text, dimension)
+        except ValueError as exc:
+            raise UsageError(f"argument {option}: {exc}") from None
+    return values
+
+
+def _library_call(func, *args, **kwargs):
+    """Run a library call, turning its ValueError into the CLI's one-line error."""
+    try:
+        return func(*args, **kwargs)
+    except ValueError as exc:
+        raise UsageError(_with_option(str(exc))) from None
+
+
+def _with_option(message: str) -> str:
+    """Prefix a library message with the CLI option it concerns ("mass ..." → "argument --mass: mass ...")."""
+    if message.startswith("give either"):  # a conflict: name both options as typed
+        words = message.split()
+        return f"give either --{words[2].replace('_', '-')} or --{words[4].rstrip(',').replace('_', '-')}, not both"
+    name = message.split(" ", 1)[0]
+    option = "--" + name.replace("_", "-")
+    known = {o for o, _, _ in IMPACT_OPTIONS} | {"--model", "--calibration", "--method", "--step"}
+    if option in known:
+        return f"argument {option}: {message}"
+    return message
+
+
+def _add_impact_options(parser: argparse.ArgumentParser) -> None:
+    from ..models import CALIBRATIONS, DAMPING_LAWS
+    from ..solvers import SOLVERS
+
+    group = parser.add_argument_group("fruit and impact (plain numbers are SI; units accepted)")
+    for option, _, text in IMPACT_OPTIONS:
+        group.add_argument(option, metavar="VALUE", help=text)
+    group.add_argument("--model", default="hunt-crossley", metavar="{" + ",".join(DAMPING_LAWS) + "}",
+                       help="damping law (default hunt-crossley)")
+    group.add_argument("--calibration", default="exact", metavar="{" + ",".join(CALIBRATIONS) + "}",
+                       help="exact: λ gives exactly the requested k (default); paper: the law's formula")
+    group.add_argument("--method", default="accurate", metavar="{" + ",".join(SOLVERS) + "}",
+                       help="accurate (default) or rk4, the paper's fixed-step method")
+    group.add_argument("--step", default="1e-4", metavar="VALUE", help="RK4 time step (default 1e-4 s) [s]")
+
+
+def _simulate_kwargs(args) -> dict:
+    from ..impact import Fruit
+
+    values = _quantities(args)
+    try:
+        step = parse_quantity(args.step, "time")
+    except ValueError as exc:
+        raise UsageError(f"argument --step: {exc}") from None
+    fruit_fields = {k: values[k] for k in ("mass", "diameter", "modulus", "poisson", "stiffness") if k in values}
+    fruit = _library_call(Fruit, **fruit_fields)
+    return dict(fruit=fruit, velocity=values.get("velocity"), drop_height=values.get("drop_height"),
+                restitution=values.get("restitution"), alpha=values.get("alpha"), model=args.model,
+                calibration=args.calibration, method=args.method, step=step)
+
+
+def _json_default(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return str(value)
+
+
+def _finite(obj):
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def dump_json(obj) -> str:
+    """JSON with NaN/inf written as null (strict JSON)."""
+    return json.dumps(_finite(obj), indent=2, default=_json_default, allow_nan=False)
+
+
+
+def _float_list(option: str, text: str, low: float, high: float, high_inclusive: bool) -> list[float]:
+    """"0.3,0.5,0.7" → floats, each in (low, high) or (low, high]."""
+    values = []
+    for item in text.split(","):
+        try:
+            value = float(parse_quantity(item, "velocity" if option == "--velocities" else "dimensionless"))
+        except ValueError as exc:
+            raise UsageError(f"argument {option}: {exc}") from None
+        if not (math.isfinite(value) and low < value and (value <= high if high_inclusive else value < high)):
+            bracket = "]" if high_inclusive else ")"
+            raise UsageError(f"argument {option}: each value must be in ({low:g}, {high:g}{bracket}; got {item!r}")
+        values.append(value)
+    return values
+
+
+
+#: Numeric inputs of sweep and population: (option, column, dimension); text inputs: (option, column).
+RUN_NUMERIC = tuple((option, _dest(option), dimension) for option, dimension, _ in IMPACT_OPTIONS) \
+    + (("--step", "step", "time"),)
+RUN_TEXT = (("--model", "model"), ("--calibration", "calibration"), ("--method", "method"))
+#: Inputs whose range depends on other inputs: not checked alone when constant.
+_DEPENDENT_INPUTS = ("alpha", "step")
+
+
+class _Ordered(argparse.Action):
+    """Store the value and remember the order in which the options were given (sweep axes)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        namespace.order = [d for d in (getattr(namespace, "order", None) or []) if d != self.dest] + [self.dest]
+
+
+def _positive_count(option: str, text: str, minimum: int = 1) -> int:
+    """"1e7" or "10000000" → int >= minimum."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value == int(value) and value >= minimum):
+        raise UsageError(f"argument {option}: must be an integer >= {minimum}; got {text!r}")
+    return int(value)
+
+
+
+_SI_OF = {"mass": "kg", "diameter": "m", "modulus": "Pa", "poisson": "", "stiffness": "N/m^1.5", "velocity": "m/s",
+          "drop_height": "m", "restitution": "", "alpha": "s/m", "step": "s"}
+
+
+
+_NEGATIVE = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+
+
+def _attach_negative_values(argv: list[str]) -> list[str]:
+    """Let "--drop-height -3cm" reach our range check instead of argparse's
+    "expected one argument": glue a value that starts with "-<digit>" to its option."""
+    glued = []
+    i = 0
+    while i < len(argv):
+        token = argv[i]
+        if (token.startswith("--") and "=" not in token and i + 1 < len(argv)
+                and _NEGATIVE.match(argv[i + 1])):
+            glued.append(f"{token}={argv[i + 1]}")
+            i += 2
+            continue
+        glued.append(token)
+        i += 1
+    return glued
+
+
+def _numba_without_blas() -> None:
+    """Start numba's CPU target without letting it import SciPy's BLAS.
+
+    On its first compiled call numba imports ``scipy.linalg.cython_blas`` (about
+    0.2 s) only to offer ``np.dot`` inside compiled code, which the engine never
+    uses.  In the CLI's own process we refuse that import while the target
+    initialises; library users (who may want numba's np.dot) are not affected."""
+    if "scipy.linalg.cython_blas" in sys.modules:
+        return
+    sys.modules["scipy.linalg.cython_blas"] = None  # makes the import raise ImportError
+    try:
+        from numba.core.registry import cpu_target
+
+        cpu_target.target_context.refresh()
+    finally:
+        del sys.modules["scipy.linalg.cython_blas"]
+
