@@ -48,8 +48,10 @@ def run(capsys, *argv):
 def run_json(capsys, *argv) -> dict:
     status, out, err = run(capsys, *argv, "--json")
     assert status == 0, err
-    assert err == ""
-    return json.loads(out)
+    report = json.loads(out)
+    # stderr holds nothing but the warnings the object carries (a contact beyond Hertz's range ...)
+    assert err.splitlines() == [f"fruitimpact simulate: warning: {w}" for w in report["warnings"]], err
+    return report
 
 
 def error_line(capsys, *argv) -> str:
@@ -157,25 +159,10 @@ def test_drop_height_gives_free_fall_velocity(capsys):
     assert result["exit_velocity"] == pytest.approx(0.577 * math.sqrt(2 * G * 0.3), rel=1e-8)
 
 
-@pytest.mark.parametrize("argv, velocity", [
-    (["--alpha", "0.3", "--velocity", "1.2"], 1.2),
-    (["--alpha", "0.2", "--drop-height", "0.2"], math.sqrt(2 * G * 0.2)),
-    (["--alpha", "0.5"], 1.0),
-])
-@pytest.mark.parametrize("model", ["hunt-crossley", "chen"])
-def test_alpha_sets_target_restitution_one_minus_alpha_v(capsys, argv, velocity, model):
-    alpha = float(argv[1])
-    result = run_json(capsys, *argv, "--model", model)
-    target = 1.0 - alpha * velocity
-    assert result["alpha"] == pytest.approx(alpha, rel=1e-15)
-    assert result["target_restitution"] == pytest.approx(target, rel=1e-12)
-    assert result["restitution"] == pytest.approx(target, abs=1e-8)  # exact calibration by default
-
-
 def test_alpha_zero_is_elastic(capsys):
-    """α = 0 is k = 1 (the closed end of the range, like --restitution 1)."""
+    """α = 0 is λ = 0 (eq 5): the elastic Hertz impact.  Any α ≥ 0: test_damping_inputs.py."""
     result = run_json(capsys, "--alpha", "0")
-    assert result["target_restitution"] == 1.0
+    assert result["target_restitution"] is None
     assert result["restitution"] == pytest.approx(1.0, abs=1e-12)
     assert result["damping"] == 0.0
 
@@ -417,14 +404,9 @@ BAD_CASES += [
     (["--velocity", "1", "--drop-height", "30cm"], ["--velocity", "--drop-height"], ["not both"]),
     (["--drop-height", "0.3", "--velocity", "2m/s"], ["--velocity", "--drop-height"], ["not both"]),
     (["--restitution", "0.5", "--alpha", "0.1"], ["--restitution", "--alpha"], ["not both"]),
-    # alpha with k = 1 - α V_i ≤ 0 (or > 1): the message states the upper bound 1/V_i
-    (["--alpha", "1"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
-    (["--alpha", "2"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
-    (["--velocity", "2", "--alpha", "0.5"], ["--alpha"], [", 0.5)", "1 - alpha*V_i"]),
-    (["--velocity", "4", "--alpha", "0.3"], ["--alpha"], [", 0.25)", "1 - alpha*V_i"]),
-    (["--drop-height", "1m", "--alpha", "0.5"], ["--alpha"], [f", {1 / math.sqrt(2 * G):g})"]),
-    (["--alpha", "-0.1"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
-    (["--alpha", "nan"], ["--alpha"], [", 1)", "1 - alpha*V_i"]),
+    # α is any number >= 0 (eq 5); only negative numbers and NaN are refused
+    (["--alpha", "-0.1"], ["--alpha"], [">= 0 s/m"]),
+    (["--alpha", "nan"], ["--alpha"], [">= 0 s/m"]),
 ]
 
 

@@ -1,224 +1,359 @@
 """Many impacts at once: a table of inputs in, a table of characteristics out.
 
-``evaluate(frame)`` takes rows named like ``fruitimpact simulate``'s options
-(mass, diameter, modulus, poisson, stiffness, velocity, drop_height,
-restitution, alpha, model, calibration, method, step; plain SI numbers or
-strings with units) and returns, per row, the resolved inputs, the contact
-law, every characteristic, a ``status`` ("ok", "invalid" or "failed") and a
-``message``.  A bad row never stops the others.  The numbers come from the
-same compiled kernels as ``simulate``, so a batch row equals the single
-impact with the same inputs.
+``evaluate(table)`` takes rows named like ``fruitimpact simulate``'s options
+(the inputs of ``quantities.INPUTS``: mass, diameter, modulus, poisson,
+stiffness, velocity, drop_height, restitution, alpha, damping, the surface,
+step, model, calibration, method; plain SI numbers or strings with units)
+and returns, per row, the inputs as used, the contact law, every
+characteristic, a ``status`` (``ok``, ``inaccurate``, ``failed``,
+``invalid``), a ``message`` and ``warnings``.  A bad row never stops the
+others.  ``simulate()`` is this function on one row: there is one path from
+inputs to results, one validation and one judgement.
+
+The work is vectorised end to end: validation on whole columns, one call of
+the compiled kernels per (model, method) group, messages as integer codes
+(``validation.MessageBook``) turned into categorical columns only at the end.
 """
 
 from __future__ import annotations
 
-import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from . import contact
 from .calibrate import damping_factor as calibrated_damping_factor
-from .calibrate import law_params
-from .constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY, STANDARD_GRAVITY
-from .engine import forces
-from .engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS
-from .models import CALIBRATIONS, DAMPING_LAWS
-from .solvers import SOLVERS, judge_batch, max_rk4_step
-from .units import parse_quantity
-from .validation import positive_message, range_message
+from .constants import STANDARD_GRAVITY
+from .engine.powerlaw import CHARACTERISTIC_COLUMNS, CONTACT_RADIUS, N_CHARACTERISTICS
+from .inputs import InputColumns, read_columns
+from .models import DAMPING_LAWS
+from .registries import REGISTRIES
+from .quantities import ALTERNATIVES, GROUP_DEFAULTS, INPUTS, NUMERIC_INPUTS, TEXT_INPUTS
+from .solvers import SOLVERS, max_rk4_step, power_law_closed_forms
+from .status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
+from .labels import Labels
+from .validation import (MessageBook, WarningBook, conflict_message, implausible_message, nan_message,
+                         range_message)
 
-#: Input columns, their dimension and default (None: optional, NaN when absent).
-INPUT_COLUMNS = {
-    "mass": ("mass", JONATHAN_APPLE["mass"]),
-    "diameter": ("length", JONATHAN_APPLE["diameter"]),
-    "modulus": ("modulus", JONATHAN_APPLE["modulus"]),
-    "poisson": ("dimensionless", JONATHAN_APPLE["poisson"]),
-    "stiffness": ("stiffness", None),
-    "velocity": ("velocity", None),
-    "drop_height": ("length", None),
-    "restitution": ("dimensionless", None),
-    "alpha": ("alpha", None),
-    "step": ("time", 1e-4),
-}
-TEXT_COLUMNS = {"model": "hunt-crossley", "calibration": "exact", "method": "accurate"}
-LAW_COLUMNS = ("stiffness", "damping", "damping_factor")
-# the requested restitution is reported as target_restitution (k, or 1 - α V_i), since
-# "restitution" is the achieved one
-OUTPUT_COLUMNS = (tuple(c for c in INPUT_COLUMNS if c != "restitution") + tuple(TEXT_COLUMNS) + ("target_restitution",)
-                  + ("law_stiffness", "damping", "damping_factor") + CHARACTERISTIC_COLUMNS + ("status", "message"))
+#: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is
+#: ``damping``, given or calibrated).
+INPUT_OUTPUTS = tuple(name for name in NUMERIC_INPUTS if name not in ("restitution", "damping")) + TEXT_INPUTS
+LAW_COLUMNS = ("target_restitution", "law_stiffness", "damping", "damping_factor")
+OUTPUT_COLUMNS = INPUT_OUTPUTS + LAW_COLUMNS + CHARACTERISTIC_COLUMNS + ("status", "message", "warnings")
+#: Contact radius / effective radius beyond which Hertz's theory is left: the paraboloid that
+#: replaces the sphere in Hertz's solution is then more than (a/R)²/4 = 4 % off at the contact edge.
+HERTZ_RANGE = 0.4
+
+# compatibility names of earlier versions: numeric input columns (dimension, default) and text columns
+INPUT_COLUMNS = {name: (INPUTS[name].dimension, INPUTS[name].default) for name in NUMERIC_INPUTS}
+TEXT_COLUMNS = {name: INPUTS[name].default for name in TEXT_INPUTS}
 
 
-def _numeric_column(frame, name, dimension, default, rows, messages):
-    """Column as float64 (NaN = not given); unit strings parsed cell by cell."""
-    if name not in frame:
-        return np.full(rows, np.nan if default is None else default)
-    column = frame[name]
-    values = np.asarray(column.to_numpy() if hasattr(column, "to_numpy") else column)
-    unreadable = np.zeros(rows, dtype=bool)
-    if values.dtype.kind in "fiu":
-        out = values.astype(float)
-    else:
-        out = np.empty(rows)
-        for i, cell in enumerate(values):
-            if cell is None or (isinstance(cell, float) and math.isnan(cell)) or (isinstance(cell, str) and not cell.strip()):
-                out[i] = np.nan
-                continue
-            try:
-                out[i] = parse_quantity(cell, dimension)
-            except ValueError as exc:
-                out[i] = np.nan
-                unreadable[i] = True
-                messages[i] = messages[i] or f"{name}: {exc}"
-            else:
-                if not math.isfinite(out[i]):
-                    messages[i] = messages[i] or f"{name} must be a finite number; got {cell!r}"
-    if default is not None:  # an empty cell takes the default, as an omitted option does
-        out = np.where(np.isnan(out) & ~unreadable, default, out)
-    return out
+@dataclass
+class Evaluation:
+    """Everything ``evaluate`` found, as arrays: output ``columns`` by name (float arrays,
+    and ``Labels`` for the text columns), ``status`` codes (``status.STATUS_NAMES``),
+    ``messages`` and ``warnings`` books, and for the power-law rows the closed-form
+    self-check (δ_max, e) when asked for."""
+
+    rows: int
+    columns: dict
+    status: np.ndarray
+    messages: MessageBook
+    warnings: WarningBook
+    closed_forms: np.ndarray | None = None
+
+    def labels(self) -> dict[str, Labels]:
+        """``status``, ``message`` and ``warnings`` as ``Labels`` (no message on a row: its status)."""
+        messages = self.messages
+        codes, categories = self.warnings.categories()
+        return {"status": Labels(self.status.astype(np.int32), STATUS_NAMES),
+                "message": Labels(messages.codes, ("ok",) + tuple(messages.texts[1:])),
+                "warnings": Labels(codes, tuple(categories))}
+
+    def _all(self) -> dict:
+        return {**self.columns, **self.labels()}
+
+    def frame(self):
+        """A pandas DataFrame of ``OUTPUT_COLUMNS`` (text columns categorical; no copies)."""
+        import pandas as pd
+
+        data = {name: value.to_pandas() if isinstance(value, Labels) else value for name, value in self._all().items()}
+        return pd.DataFrame({name: data[name] for name in OUTPUT_COLUMNS}, copy=False)
+
+    def table(self):
+        """A pyarrow Table of ``OUTPUT_COLUMNS`` (text columns dictionary-encoded; floats not copied)."""
+        import pyarrow as pa
+
+        data = self._all()
+        arrays = [data[name].to_arrow() if isinstance(data[name], Labels) else pa.array(data[name])
+                  for name in OUTPUT_COLUMNS]
+        return pa.Table.from_arrays(arrays, names=list(OUTPUT_COLUMNS))
 
 
-def _require(mask_bad, message, messages):
-    for i in np.flatnonzero(mask_bad):
-        if not messages[i]:
-            messages[i] = message
+def _check_ranges(inputs: InputColumns, messages: MessageBook, detail: bool) -> None:
+    if detail:  # one impact: the NaN refusals read from the cells get the value, as range refusals do
+        for i in np.flatnonzero(messages.flagged):
+            name = messages.argument(i)
+            if isinstance(name, str) and name in inputs.values and np.isnan(inputs.values[name][i]) \
+                    and messages.text(i) == nan_message(INPUTS[name]):
+                messages.codes[i] = messages.code(f"{nan_message(INPUTS[name])}; got nan", name)
+    for name in NUMERIC_INPUTS:
+        quantity = INPUTS[name]
+        if not inputs.given[name].any():
+            continue
+        bad = inputs.given[name] & ~messages.flagged & ~quantity.allowed.contains(inputs.values[name])
+        if bad.any():
+            text = range_message(quantity)
+            if detail:
+                text += f"; got {float(inputs.values[name][0])!r}"
+            messages.set(bad, text, name)
+    for group in ALTERNATIVES:
+        count = sum(inputs.given[name].astype(np.int8) for name in group)
+        if np.any(count > 1):
+            for i in np.flatnonzero(count > 1):
+                named = [name for name in group if inputs.given[name][i]]
+                messages.set_row(i, conflict_message(named), tuple(named))
 
 
-def evaluate(frame, tabulated: bool | None = None) -> "pandas.DataFrame":  # noqa: F821
-    """Characteristics of every row of ``frame`` (a DataFrame or a dict of columns).
+def _check_text(inputs: InputColumns, messages: MessageBook) -> None:
+    for name, registry in REGISTRIES.items():
+        labels = inputs.text[name]
+        for code, value in enumerate(labels.labels):
+            if not (isinstance(value, str) and value in registry):
+                messages.set(labels.codes == code, f"{name} must be one of {', '.join(registry)}; got {value!r}",
+                             name)
 
-    ``tabulated`` is passed to ``engine.powerlaw.powerlaw_characteristics``: True
-    makes power-law rows independent of how a run is split into chunks (the
-    table agrees with the exact kernel to ~1e-13; by default it is used for
-    groups of more than 20000 rows).
 
-    Returns a DataFrame with ``OUTPUT_COLUMNS``: the inputs as used (SI), the
-    contact law (``law_stiffness`` [N/m^1.5, N/m for Kelvin–Voigt], ``damping``,
-    ``damping_factor``), the characteristics, ``status`` and ``message``.
-    """
-    import pandas as pd
+def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> None:
+    for name in NUMERIC_INPUTS:
+        quantity = INPUTS[name]
+        if quantity.plausible is None or not inputs.given[name].any():
+            continue
+        outside = inputs.given[name] & np.isfinite(inputs.values[name]) & \
+            ~quantity.plausible.contains(inputs.values[name])
+        if outside.any():
+            warnings.add(outside, implausible_message(quantity, inputs.values[name][0] if detail else None))
 
-    if not isinstance(frame, pd.DataFrame):
-        frame = pd.DataFrame(frame)
-    rows = len(frame)
-    messages = np.array([""] * rows, dtype=object)
-    values = {name: _numeric_column(frame, name, dim, default, rows, messages)
-              for name, (dim, default) in INPUT_COLUMNS.items()}
-    text = {}
-    for name, default in TEXT_COLUMNS.items():
-        column = (frame[name].astype(object).where(frame[name].notna(), default).astype(str).str.strip()
-                  if name in frame else None)
-        text[name] = column.to_numpy(dtype=object) if column is not None else np.full(rows, default, dtype=object)
 
-    # -- validation: one message per bad row, the same wording as simulate()
-    def positive(name, unit, optional):
-        value = values[name]
-        bad = ~(np.isfinite(value) & (value > 0))
-        if optional:
-            bad &= ~np.isnan(value)
-        _require(bad, positive_message(name, unit), messages)
+def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: bool | None = None,
+                    detail: bool = False, closed_forms: bool = False) -> Evaluation:
+    """The core of ``evaluate``: validated, resolved and computed rows, all arrays.
 
-    for name, unit in (("mass", "kg"), ("diameter", "m"), ("modulus", "Pa"), ("step", "s")):
-        positive(name, unit, optional=False)
-    for name, unit in (("stiffness", "N/m^1.5"), ("velocity", "m/s"), ("drop_height", "m")):
-        positive(name, unit, optional=True)
-    poisson = values["poisson"]
-    _require(~((poisson > -1) & (poisson < 0.5)), range_message("poisson", -1, 0.5), messages)
-    _require(~np.isnan(values["velocity"]) & ~np.isnan(values["drop_height"]),
-             "give either velocity or drop_height, not both", messages)
-    _require(~np.isnan(values["restitution"]) & ~np.isnan(values["alpha"]),
-             "give either restitution or alpha, not both", messages)
-    for name, registry, label in (("model", DAMPING_LAWS, "model"), ("calibration", CALIBRATIONS, "calibration"),
-                                  ("method", SOLVERS, "method")):
-        _require(~np.isin(text[name], list(registry)), f"{label} must be one of {', '.join(registry)}", messages)
+    ``detail`` (one row, the single-impact API) puts the offending value in messages;
+    ``closed_forms`` adds the power-law first-integral self-check."""
+    rows = inputs.rows
+    values, given = inputs.values, inputs.given
+    warnings = WarningBook(rows)
+    _check_ranges(inputs, messages, detail)
+    codes = {name: inputs.text[name].codes for name in REGISTRIES}
+    uniques = {name: inputs.text[name].labels for name in REGISTRIES}
+    _check_text(inputs, messages)
+    _plausibility(inputs, warnings, detail)
 
-    with np.errstate(invalid="ignore"):  # a given velocity wins, so a conflicting row records what was given
-        velocity = np.where(~np.isnan(values["velocity"]), values["velocity"],
-                            np.where(np.isnan(values["drop_height"]), JONATHAN_VELOCITY,
-                                     np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"]))))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        alpha = values["alpha"]
-        bad_alpha = ~np.isnan(alpha) & ~((alpha >= 0) & (alpha < 1.0 / velocity))
-        _require(bad_alpha, "alpha must be in [0, 1/V_i) s/m (so that k = 1 - alpha*V_i is in (0, 1])", messages)
-        target = np.where(np.isnan(alpha), np.where(np.isnan(values["restitution"]), JONATHAN_RESTITUTION,
-                                                    values["restitution"]), 1.0 - alpha * velocity)
-        _require(np.isnan(alpha) & ~((target > 0) & (target <= 1)),
-                 range_message("restitution", 0, 1, high_inclusive=True), messages)
-        hertz = contact.rigid_plane_stiffness(values["modulus"], poisson, values["diameter"])
-    stiffness = np.where(np.isnan(values["stiffness"]), hertz, values["stiffness"])
-    radius = values["diameter"] / 2.0
-    mass = values["mass"]
-    rk4 = text["method"] == "rk4"
-    _require(rk4 & ~(values["step"] <= max_rk4_step(mass, stiffness, velocity)),
-             "step must be at most 1/20 of the contact duration for rk4 (at least 20 steps per contact)", messages)
+    used = {name: np.where(given[name], values[name], INPUTS[name].default if INPUTS[name].default is not None
+                           else np.nan) for name in NUMERIC_INPUTS}
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        velocity = np.where(given["velocity"], values["velocity"],
+                            np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
+                                     GROUP_DEFAULTS["velocity"]))
+        radius = contact.effective_radius(used["diameter"] / 2.0, used["surface_radius"])
+        hertz = contact.hertz_stiffness(contact.effective_modulus(used["modulus"], used["poisson"],
+                                                                  used["surface_modulus"], used["surface_poisson"]),
+                                        radius)
+    stiffness = np.where(given["stiffness"], values["stiffness"], hertz)
+    damped_given = given["alpha"] | given["damping"]
+    target = np.where(given["restitution"], values["restitution"],
+                      np.where(damped_given, np.nan, GROUP_DEFAULTS["restitution"]))
+    used["velocity"], used["stiffness"] = velocity, stiffness
+    mass = used["mass"]
 
-    valid = messages == ""
-    out = np.full((rows, N_CHARACTERISTICS), np.nan)
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
-    status = np.where(valid, "ok", "invalid").astype(object)
+    model_codes = codes["model"]
+    for code, model in enumerate(uniques["model"]):
+        law = DAMPING_LAWS.get(model) if isinstance(model, str) else None
+        if law is None:
+            continue
+        in_model = (model_codes == code) & ~messages.flagged
+        family = law.force_family
+        if not family.alpha:
+            messages.set(in_model & given["alpha"],
+                         f"alpha is Hunt–Crossley's damping parameter of the power-law laws; model {model} is "
+                         f"{family.formula}: give restitution, or damping ({family.damping_symbol} "
+                         f"[{family.damping_unit}])", "alpha")
+            in_model &= ~messages.flagged
+        idx = np.flatnonzero(in_model)
+        if idx.size == 0:
+            continue
+        m, k, v = mass[idx], stiffness[idx], velocity[idx]
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+            k_law = np.asarray(law.linear_stiffness(m, k, v), dtype=float) * np.ones(idx.size)
+        law_stiffness[idx] = k_law
+        if law.undamped:
+            factor[idx] = 0.0
+            given_any = given["restitution"][idx] | damped_given[idx]
+            warnings.add(_mask(idx[given_any], rows), f"model {model} is undamped (e = 1): the restitution, "
+                                                      f"alpha or damping given is ignored")
+            continue
+        from_damping = given["damping"][idx]
+        from_alpha = given["alpha"][idx]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            factor[idx[from_damping]] = values["damping"][idx[from_damping]] / k_law[from_damping]
+        factor[idx[from_alpha]] = 1.5 * values["alpha"][idx[from_alpha]]  # c = λ/k_c = 1.5 α (eq 5)
+        calibrate = ~(from_damping | from_alpha)
+        calibrations = codes["calibration"][idx]
+        for cal_code, calibration in enumerate(uniques["calibration"]):
+            sub = calibrate & (calibrations == cal_code)
+            if sub.any():
+                rows_sub = idx[sub]
+                with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+                    factor[rows_sub] = calibrated_damping_factor(law, calibration, target[rows_sub], mass[rows_sub],
+                                                                 stiffness[rows_sub], velocity[rows_sub])
+                unreachable = rows_sub[~np.isfinite(factor[rows_sub]) & np.isfinite(law_stiffness[rows_sub])]
+                messages.set(_mask(unreachable, rows),
+                             f"model {model} cannot reach this restitution with calibration {calibration} "
+                             f"(see fruitimpact models for the range it reaches)", "restitution")
 
-    # -- resolve the damping and integrate, group by (model, calibration, method)
-    codes, labels = zip(*(pd.factorize(text[name]) for name in TEXT_COLUMNS))
-    keys = (codes[0] * len(labels[1]) + codes[1]) * len(labels[2]) + codes[2]
-    for key in np.unique(keys[valid]):
-        rest, method_code = divmod(int(key), len(labels[2]))
-        model_code, calibration_code = divmod(rest, len(labels[1]))
-        model, calibration, method = labels[0][model_code], labels[1][calibration_code], labels[2][method_code]
+    step = used["step"]
+    rk4 = np.zeros(rows, dtype=bool)
+    for code, method in enumerate(uniques["method"]):
+        if method == "rk4":
+            rk4 |= codes["method"] == code
+    if rk4.any():
+        limit = max_rk4_step(mass, stiffness, velocity)
+        too_coarse = rk4 & ~messages.flagged & ~(step <= limit)
+        if too_coarse.any():
+            text = "step must be at most 1/20 of the contact duration for rk4 (at least 20 steps per contact)"
+            if detail:
+                text = (f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
+                        f"{20} steps per contact); got {float(step[0])!r}")
+            messages.set(too_coarse, text, "step")
+
+    status = np.full(rows, INVALID, dtype=np.int8)
+    out = np.full((rows, N_CHARACTERISTICS), np.nan)
+    valid = ~messages.flagged
+    # inputs that are legal but whose scales leave double precision (V_i = 1e-160 m/s): failed, not computed
+    collapsed = valid & ~(np.isfinite(law_stiffness) & (law_stiffness > 0) & np.isfinite(factor)
+                          & (max_rk4_step(mass, stiffness, velocity) > 0))
+    status[collapsed] = FAILED
+    messages.set(collapsed, UNDERFLOW_MESSAGE)
+    valid &= ~collapsed
+    groups = codes["model"] * max(len(uniques["method"]), 1) + codes["method"]
+    for key in np.unique(groups[valid]):
+        model = uniques["model"][key // max(len(uniques["method"]), 1)]
+        solver = SOLVERS[uniques["method"][key % max(len(uniques["method"]), 1)]]
         law = DAMPING_LAWS[model]
-        idx = np.flatnonzero(valid & (keys == key))
-        m, k, v, e, r = mass[idx], stiffness[idx], velocity[idx], target[idx], radius[idx]
-        factor[idx] = calibrated_damping_factor(law, calibration, e, m, k, v)
-        law_stiffness[idx] = law.linear_stiffness(m, k, v)
-        out[idx] = SOLVERS[method].batch(law.family, law.clamp, law_stiffness[idx], factor[idx], m, v, r,
-                                         values["step"][idx], tabulated)
-    computed = valid & ~judge_batch(out)
-    status[computed] = "failed"
-    messages[computed] = "solver did not reach separation (non-finite characteristics)"
-    messages[status == "ok"] = "ok"
+        idx = np.flatnonzero(valid & (groups == key))
+        arguments = (law_stiffness[idx], factor[idx], mass[idx], velocity[idx], radius[idx], step[idx], tabulated)
+        out[idx] = solver.batch(law, *arguments)
+        reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
+        judge(out, idx, status, messages, solver=solver, velocity=velocity, mass=mass, step=step,
+              reference=reference)
 
-    data = {name: values[name] for name in INPUT_COLUMNS if name != "restitution"}
-    data["velocity"] = velocity
-    data["stiffness"] = stiffness
-    data.update(text)
-    data["target_restitution"] = target
-    data["law_stiffness"] = law_stiffness
-    data["damping"] = factor * law_stiffness
-    data["damping_factor"] = factor
+    with np.errstate(invalid="ignore", divide="ignore"):
+        leaves_hertz = (status != INVALID) & (out[:, CONTACT_RADIUS] > HERTZ_RANGE * radius)
+    if leaves_hertz.any():
+        ratio = f" = {float(out[0, CONTACT_RADIUS] / radius[0]):.2g}" if detail else ""
+        warnings.add(leaves_hertz, f"the contact radius leaves Hertz's range: a/R{ratio} > {HERTZ_RANGE:g} "
+                                   f"(δ_max/R > {HERTZ_RANGE ** 2:g}), where the paraboloid that Hertz puts in "
+                                   f"place of the fruit is more than 4 % off; treat the figures as an estimate")
+
+    columns = {name: used[name] for name in NUMERIC_INPUTS if name in INPUT_OUTPUTS}
+    columns["drop_height"] = np.where(given["drop_height"], values["drop_height"], np.nan)
+    columns["alpha"] = np.where(given["alpha"], values["alpha"], np.nan)
+    for name in TEXT_INPUTS:
+        columns[name] = inputs.text[name]
+    columns["target_restitution"] = target
+    columns["law_stiffness"] = law_stiffness
+    columns["damping"] = factor * law_stiffness
+    columns["damping_factor"] = factor
     for j, name in enumerate(CHARACTERISTIC_COLUMNS):
-        data[name] = out[:, j]
-    data["status"] = status
-    data["message"] = messages
-    return pd.DataFrame(data, columns=list(OUTPUT_COLUMNS))
+        columns[name] = out[:, j]
+    closed = None
+    if closed_forms:
+        closed = np.full((rows, 2), np.nan)
+        for code, model in enumerate(uniques["model"]):
+            law = DAMPING_LAWS.get(model) if isinstance(model, str) else None
+            idx = np.flatnonzero((model_codes == code) & (status != INVALID))
+            if law is not None and law.force_family.first_integral and idx.size:
+                closed[idx, 0], closed[idx, 1] = power_law_closed_forms(law_stiffness[idx], factor[idx], mass[idx],
+                                                                        velocity[idx])
+    return Evaluation(rows, columns, status, messages, warnings, closed)
 
 
-def curves(frame, times=None, points: int = 201):
-    """Curves of every valid row of ``frame``: a dict with ``row`` (the row numbers),
-    ``time`` [s], ``deflection`` [m], ``rate`` [m/s] and ``force`` [N], each of shape
-    (rows, points).  ``times`` [s] is a common grid (points,) or one grid per row
-    (rows, points); by default each row gets ``points`` samples over its own [0, T]."""
-    results = evaluate(frame)
-    rows = np.flatnonzero(results["status"].to_numpy() == "ok")
-    ok = results.iloc[rows]
+def _mask(index: np.ndarray, size: int) -> np.ndarray:
+    mask = np.zeros(size, dtype=bool)
+    mask[index] = True
+    return mask
+
+
+def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.DataFrame":  # noqa: F821
+    """Characteristics of every row of ``table``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame, mapping of column → values, or pyarrow.Table
+        Columns named like the inputs of ``quantities.INPUTS`` (``-`` may stand for
+        ``_``); an unknown column is refused (``ValueError``) before any work.  Cells
+        are numbers [SI] or strings with units; None, pd.NA, an Arrow null or an empty
+        string means "not given" (the default); NaN is invalid.
+    tabulated : bool or None
+        Passed to ``engine.powerlaw.powerlaw_characteristics``: True makes power-law rows
+        independent of how a run is split into chunks (the table agrees with the exact
+        kernel to ~1e-13; by default it is used for groups of more than 20000 rows).
+    errors : sequence of str, optional
+        A message per row ("" or None: none); rows with one are invalid with it and
+        their cells are not read (a file reader's verdict, e.g. a ragged CSV row).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``OUTPUT_COLUMNS``: the inputs as used (SI), ``target_restitution``, the contact
+        law (``law_stiffness`` [N/m^1.5, N/m for Kelvin–Voigt], ``damping``,
+        ``damping_factor``), the characteristics, and categorical ``status``
+        (ok, inaccurate, failed, invalid), ``message`` and ``warnings``.
+    """
+    rows = None
+    messages = None
+    if errors is not None:
+        errors = list(errors)
+        rows = len(errors)
+        messages = MessageBook(rows)
+        for i, text in enumerate(errors):
+            if text:
+                messages.set_row(i, str(text))
+    inputs, messages = read_columns(table, messages, rows)
+    return evaluate_inputs(inputs, messages, tabulated=tabulated).frame()
+
+
+def curves(table, times=None, points: int = 201):
+    """Curves of every ok row of ``table``, each from its own solver (``--method``):
+    a dict with ``row`` (the row numbers), ``time`` [s], ``deflection`` [m], ``rate``
+    [m/s] and ``force`` [N], each of shape (rows, points).  ``times`` [s] is a common
+    grid (points,) or one grid per row (rows, points); by default each row gets
+    ``points`` samples over its own [0, T]."""
+    inputs, messages = read_columns(table)
+    result = evaluate_inputs(inputs, messages)
+    rows = np.flatnonzero(result.status == 0)
+    columns = {name: array[rows] if isinstance(array, Labels) else np.asarray(array)[rows]
+               for name, array in result.columns.items()}
     if times is None:
-        grid = np.linspace(0.0, 1.0, int(points))[None, :] * ok["contact_duration"].to_numpy()[:, None]
+        grid = np.linspace(0.0, 1.0, int(points))[None, :] * columns["contact_duration"][:, None]
     else:
         grid = np.broadcast_to(np.asarray(times, dtype=float), (len(rows), np.shape(times)[-1])).copy()
-    shape = grid.shape
-    deflection, rate, force = np.empty(shape), np.empty(shape), np.empty(shape)
-    for model, group in ok.groupby("model", sort=False):
-        law = DAMPING_LAWS[model]
-        idx = np.flatnonzero(ok["model"].to_numpy() == model)
-        m, v = group["mass"].to_numpy(), group["velocity"].to_numpy()
-        k, c = group["law_stiffness"].to_numpy(), group["damping_factor"].to_numpy()
-        if law.family == forces.POWER_LAW:
-            from .engine.powerlaw import powerlaw_curves_batch
-
-            deflection[idx], rate[idx], force[idx] = powerlaw_curves_batch(m, k, c, v, grid[idx])
-        else:
-            from .engine.adaptive import adaptive_curves
-
-            params = law_params(law.family, k, c)
-            for j, i in enumerate(idx):
-                deflection[i], rate[i], force[i], _ = adaptive_curves(law.family, params[j], law.clamp, m[j], v[j],
-                                                                      grid[i])
+    deflection, rate, force = np.empty(grid.shape), np.empty(grid.shape), np.empty(grid.shape)
+    models, methods = columns["model"], columns["method"]
+    keys = models.codes.astype(np.int64) * len(methods.labels) + methods.codes
+    for key in np.unique(keys):
+        idx = np.flatnonzero(keys == key)
+        law = DAMPING_LAWS[models.labels[key // len(methods.labels)]]
+        solver = SOLVERS[methods.labels[key % len(methods.labels)]]
+        deflection[idx], rate[idx], force[idx] = solver.curves(
+            law, columns["law_stiffness"][idx], columns["damping_factor"][idx], columns["mass"][idx],
+            columns["velocity"][idx], columns["step"][idx], grid[idx])
     return dict(row=rows, time=grid, deflection=deflection, rate=rate, force=force)
+
+
+__all__ = ["Evaluation", "HERTZ_RANGE", "INPUT_COLUMNS", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES", "TEXT_COLUMNS",
+           "curves", "evaluate", "evaluate_inputs"]

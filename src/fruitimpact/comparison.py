@@ -14,15 +14,12 @@ from __future__ import annotations
 import numpy as np
 
 from .calibrate import achieved_restitution, damping_factor
-from .engine import forces
 from .engine.powerlaw import exact_restitution
 from .impact import Fruit, resolve_stiffness
 from .models import DAMPING_LAWS
 
 DEFAULT_TARGETS = (0.1, 0.3, 0.5, 0.7, 0.9)
 DEFAULT_VELOCITIES = (0.5, 1.0, 3.0)
-FAMILY_NAMES = {forces.POWER_LAW: "K δ^1.5 (1 + c δ̇)", forces.KELVIN_VOIGT: "k δ + b δ̇",
-                forces.KUWABARA_KONO: "K (δ^1.5 + B δ^0.5 δ̇)", forces.TSUJI: "K δ^1.5 + η δ^0.25 δ̇"}
 
 
 def unique_laws(names=None):
@@ -68,11 +65,11 @@ def restitution_table(laws=None, targets=DEFAULT_TARGETS, velocities=DEFAULT_VEL
     frames = []
     for law in unique_laws(laws):
         factor = damping_factor(law, "paper", e, m, k, v)
-        if law.family == forces.POWER_LAW:
+        if law.force_family.first_integral:
             achieved = exact_restitution(factor * v)
         else:
             achieved = achieved_restitution(law, factor, m, k, v)
-        frames.append(pd.DataFrame(dict(law=law.name, title=law.title, family=FAMILY_NAMES[law.family],
+        frames.append(pd.DataFrame(dict(law=law.name, title=law.title, family=law.force_family.formula,
                                         clamp=law.clamp, target=e, velocity=v, damping_factor=factor,
                                         achieved=achieved, error=achieved - e)))
     return pd.concat(frames, ignore_index=True)
@@ -84,7 +81,7 @@ def format_restitution_table(table) -> str:
     velocities = sorted(table["velocity"].unique())
     for name, block in table.groupby("law", sort=False):
         law = DAMPING_LAWS[name]
-        lines.append(f"{name}: {law.title}   [{FAMILY_NAMES[law.family]}{', clamped' if law.clamp and law.family != forces.POWER_LAW else ''}]")
+        lines.append(f"{name}: {law.title}   [{law.force_family.formula}{', clamped' if law.clamp and not law.force_family.first_integral else ''}]")
         lines.append(f"  validity: {law.validity}")
         if law.note:
             lines.append(f"  note: {law.note}")
@@ -94,25 +91,3 @@ def format_restitution_table(table) -> str:
             lines.append(f"  {target:>8.3f} | " + " " * 20 + "  ".join(f"{values[v]:>11.4f}" for v in velocities))
         lines.append("")
     return "\n".join(lines)
-
-
-def restitution_figure(table, velocity=None):
-    """Achieved vs requested restitution, one line per law (at one velocity)."""
-    from .plotting import _pyplot
-
-    plt = _pyplot()
-    velocity = velocity if velocity is not None else sorted(table["velocity"].unique())[len(table["velocity"].unique()) // 2]
-    fig, ax = plt.subplots(figsize=(7.5, 6), constrained_layout=True)
-    subset = table[np.isclose(table["velocity"], velocity)]
-    colours = plt.get_cmap("tab20").colors
-    for i, (name, rows) in enumerate(subset.groupby("law", sort=False)):
-        # a colour per law, a line style per family: 18 laws stay distinguishable
-        style = "-" if DAMPING_LAWS[name].family == forces.POWER_LAW else "--"
-        ax.plot(rows["target"], rows["achieved"], style, marker="o", ms=3, color=colours[i % len(colours)],
-                label=name)
-    ax.plot([0, 1], [0, 1], color="0.3", lw=1, ls="--", label="achieved = requested")
-    ax.set(xlabel="requested restitution e [-]", ylabel="achieved restitution e [-]", xlim=(0, 1), ylim=(0, 1),
-           title=f"Published calibrations at V_i = {velocity:g} m/s")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    return fig

@@ -6,8 +6,11 @@
 >>> round(result.characteristics.restitution, 6)
 0.577
 
-Everything is SI.  Inputs are validated here (``ValueError`` with the CLI's
-message); the numeric engine below takes plain floats.
+Everything is SI; strings with units are accepted too (``Fruit(mass="115g")``).
+``simulate()`` is ``batch.evaluate`` of one row: the same validation (a
+``ValueError`` with the CLI's message, naming the argument), the same
+kernels and the same judgement of the result (``status``, ``message``,
+``warnings``).
 """
 
 from __future__ import annotations
@@ -18,15 +21,13 @@ from functools import cached_property
 
 import numpy as np
 
-from . import contact
-from .calibrate import damping_factor as calibrated_damping_factor
 from .calibrate import law_params
-from .constants import (JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY,
-                        STANDARD_GRAVITY)
+from .constants import STANDARD_GRAVITY
 from .engine import forces
-from .models import get_calibration, get_law
-from .solvers import get_solver, max_rk4_step
-from .validation import check_exclusive, check_positive, check_range
+from .models import FAMILIES, ForceFamily
+from .quantities import INPUTS
+from .status import STATUS_NAMES
+from .validation import InputError, check_choice, check_value, read_value
 
 
 @dataclass(frozen=True)
@@ -46,21 +47,22 @@ class Fruit:
     stiffness : float or None
         Contact stiffness k_c [N/m^1.5] given directly; overrides the Hertz
         value from E, ν, d (eq 9).
+
+    Values may be strings with units (``"115g"``); out-of-range values raise
+    ``ValueError`` with the same one line as the CLI (``quantities.INPUTS``).
     """
 
-    mass: float = JONATHAN_APPLE["mass"]
-    diameter: float = JONATHAN_APPLE["diameter"]
-    modulus: float = JONATHAN_APPLE["modulus"]
-    poisson: float = JONATHAN_APPLE["poisson"]
+    mass: float = INPUTS["mass"].default
+    diameter: float = INPUTS["diameter"].default
+    modulus: float = INPUTS["modulus"].default
+    poisson: float = INPUTS["poisson"].default
     stiffness: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "mass", check_positive("mass", self.mass, "kg"))
-        object.__setattr__(self, "diameter", check_positive("diameter", self.diameter, "m"))
-        object.__setattr__(self, "modulus", check_positive("modulus", self.modulus, "Pa"))
-        object.__setattr__(self, "poisson", check_range("poisson", self.poisson, -1.0, 0.5))
-        if self.stiffness is not None:
-            object.__setattr__(self, "stiffness", check_positive("stiffness", self.stiffness, "N/m^1.5"))
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if value is not None or item.name != "stiffness":
+                object.__setattr__(self, item.name, check_value(item.name, value))
 
     @property
     def radius(self) -> float:
@@ -82,28 +84,16 @@ class Surface:
         Radius of curvature [m]; ``inf`` is a plane.
     """
 
-    modulus: float = math.inf
-    poisson: float = 0.0
-    radius: float = math.inf
+    modulus: float = INPUTS["surface_modulus"].default
+    poisson: float = INPUTS["surface_poisson"].default
+    radius: float = INPUTS["surface_radius"].default
 
     def __post_init__(self):
-        object.__setattr__(self, "modulus", check_range("surface modulus", self.modulus, 0.0, math.inf,
-                                                        high_inclusive=True, unit="Pa"))
-        object.__setattr__(self, "poisson", check_range("surface poisson", self.poisson, -1.0, 0.5))
-        object.__setattr__(self, "radius", check_range("surface radius", self.radius, 0.0, math.inf,
-                                                       high_inclusive=True, unit="m"))
+        for item in fields(self):
+            object.__setattr__(self, item.name, check_value("surface_" + item.name, getattr(self, item.name)))
 
 
 RIGID_PLANE = Surface()
-
-
-#: Per force family: (stiffness symbol, unit), (damping symbol, unit), damping-factor unit.
-FAMILY_UNITS = {
-    forces.POWER_LAW: (("k_c", "N/m^1.5"), ("λ", "N·s/m^2.5"), "s/m"),
-    forces.KELVIN_VOIGT: (("k", "N/m"), ("b", "N·s/m"), "s"),
-    forces.KUWABARA_KONO: (("K", "N/m^1.5"), ("K·B", "N·s/m^1.5"), "s"),
-    forces.TSUJI: (("K", "N/m^1.5"), ("η", "N·s/m^1.25"), "s·m^0.25"),
-}
 
 
 @dataclass(frozen=True)
@@ -121,7 +111,7 @@ class ContactLaw:
     exponent : float
         n [-] of the power-law family (3/2, Hertz).
     family : int
-        Force family code of ``engine.forces``.
+        Force family code of ``engine.forces`` (``force_family`` is its record).
     clamp : bool
         Whether the fruit separates as soon as the force would become tensile.
     """
@@ -133,6 +123,10 @@ class ContactLaw:
     clamp: bool = True
 
     @property
+    def force_family(self) -> ForceFamily:
+        return FAMILIES[self.family]
+
+    @property
     def damping(self) -> float:
         """Coefficient of the rate term: λ [N·s/m^2.5] (F_d = λ δ^1.5 δ̇; the paper's
         λ1, A or β), b [N·s/m] (Kelvin–Voigt), K·B (Kuwabara–Kono), η (Tsuji)."""
@@ -141,7 +135,7 @@ class ContactLaw:
     @property
     def units(self) -> tuple:
         """((stiffness symbol, unit), (damping symbol, unit), damping-factor unit) of this family."""
-        return FAMILY_UNITS[self.family]
+        return self.force_family.units
 
     def params(self) -> np.ndarray:
         """Parameter vector for the compiled force of ``family``."""
@@ -150,7 +144,9 @@ class ContactLaw:
 
 @dataclass(frozen=True)
 class ImpactInputs:
-    """Everything that defines one impact, validated, SI."""
+    """Everything that defines one impact, validated, SI.  ``velocity`` is the impact
+    velocity as used (from ``drop_height`` when that was given); ``restitution``,
+    ``alpha`` and ``damping`` are as given (at most one), None when not."""
 
     fruit: Fruit
     surface: Surface
@@ -162,13 +158,8 @@ class ImpactInputs:
     calibration: str
     method: str
     step: float
-
-    @property
-    def target_restitution(self) -> float | None:
-        """The restitution the damping was calibrated for: k, or 1 - α V_i (eq 6)."""
-        if self.alpha is not None:
-            return 1.0 - self.alpha * self.velocity
-        return self.restitution
+    damping: float | None = None
+    target_restitution: float | None = None
 
 
 @dataclass(frozen=True)
@@ -221,34 +212,55 @@ class Curves:
         return pd.DataFrame({"time_s": self.time, "deflection_m": self.deflection,
                              "rate_m_per_s": self.rate, "force_N": self.force})
 
-    def to_csv(self, path) -> None:
-        """Write the curves as CSV (columns time_s, deflection_m, rate_m_per_s, force_N)."""
+    def to_csv(self, path, argument: str = "path") -> None:
+        """Write the curves as CSV (columns time_s, deflection_m, rate_m_per_s, force_N), checked
+        first and written atomically (``outputs``); ``ValueError`` naming ``argument`` otherwise."""
+        from .outputs import CSV_FORMAT, atomic_write, check_output
+
+        check_output(path, argument, CSV_FORMAT)
         header = "time_s,deflection_m,rate_m_per_s,force_N"
-        np.savetxt(path, np.column_stack([self.time, self.deflection, self.rate, self.force]),
-                   delimiter=",", header=header, comments="", fmt="%.12g")
+        table = np.column_stack([self.time, self.deflection, self.rate, self.force])
+        atomic_write(path, lambda tmp: np.savetxt(tmp, table, delimiter=",", header=header, comments="",
+                                                  fmt="%.12g"), argument)
 
 
 @dataclass(frozen=True)
 class ImpactResult:
-    """Outcome of ``simulate``: inputs, resolved force law, characteristics,
-    curves (computed on first access), and a success flag with a message."""
+    """Outcome of ``simulate``: inputs, resolved force law, characteristics, curves
+    (computed on first access), the ``status`` (ok, inaccurate, failed), a
+    ``message`` saying what went wrong and by how much, and ``warnings``
+    (implausible inputs, a contact beyond Hertz's range)."""
 
     inputs: ImpactInputs
     law: ContactLaw
     characteristics: Characteristics
-    success: bool = True
+    status: str = "ok"
     message: str = "ok"
+    warnings: tuple = ()
     curve_points: int = field(default=1001, repr=False)
+
+    @property
+    def success(self) -> bool:
+        """True when the status is ok (physical and within the method's accuracy)."""
+        return self.status == "ok"
 
     @cached_property
     def curves(self) -> Curves:
-        """δ(t), δ̇(t), F(t) over the contact, from the same solver."""
+        """δ(t), δ̇(t), F(t) over the contact, from the same solver (the RK4 grid for rk4)."""
+        from .models import get_law
+        from .solvers import get_solver
+
+        if not math.isfinite(self.characteristics.contact_duration):
+            raise ValueError(f"no curves: the impact {self.status} ({self.message})")
         solver = get_solver(self.inputs.method)
-        return Curves(*solver.curves(self.law, self.inputs.fruit.mass, self.inputs.velocity,
-                                     self.inputs.step, self.curve_points))
+        law = get_law(self.inputs.model)
+        return Curves(*solver.samples(law, self.law.stiffness, self.law.damping_factor, self.inputs.fruit.mass,
+                                      self.inputs.velocity, self.inputs.step, self.curve_points,
+                                      self.characteristics.contact_duration))
 
     def to_dict(self) -> dict:
-        """Flat JSON-ready dict: characteristics, stiffness, damping, inputs (SI)."""
+        """Flat JSON-ready dict: characteristics, stiffness, damping, inputs (SI), status,
+        message, warnings."""
         inputs = self.inputs
         fruit = asdict(inputs.fruit)
         flat = dict(self.characteristics.as_dict())
@@ -263,11 +275,11 @@ class ImpactResult:
             target_restitution=inputs.target_restitution, alpha=inputs.alpha,
             model=inputs.model, calibration=inputs.calibration, method=inputs.method,
             step=inputs.step,
-            success=self.success, message=self.message,
+            success=self.success, status=self.status, message=self.message, warnings=list(self.warnings),
         )
         flat["inputs"] = {"fruit": fruit, "surface": asdict(inputs.surface),
                           "velocity": inputs.velocity, "drop_height": inputs.drop_height,
-                          "restitution": inputs.restitution, "alpha": inputs.alpha,
+                          "restitution": inputs.restitution, "alpha": inputs.alpha, "damping": inputs.damping,
                           "model": inputs.model, "calibration": inputs.calibration,
                           "method": inputs.method, "step": inputs.step}
         return flat
@@ -281,6 +293,8 @@ def impact_velocity(drop_height: float) -> float:
 
 def resolve_stiffness(fruit: Fruit, surface: Surface = RIGID_PLANE) -> tuple[float, float]:
     """(k_c [N/m^1.5], effective radius R [m]) of the fruit on the surface."""
+    from . import contact
+
     radius = float(contact.effective_radius(fruit.radius, surface.radius))
     if fruit.stiffness is not None:
         return fruit.stiffness, radius
@@ -288,53 +302,32 @@ def resolve_stiffness(fruit: Fruit, surface: Surface = RIGID_PLANE) -> tuple[flo
     return float(contact.hertz_stiffness(e_star, radius)), radius
 
 
-def prepare(fruit: Fruit | None = None, *, velocity=None, drop_height=None, restitution=None,
-            alpha=None, model: str = "hunt-crossley", calibration: str = "exact",
-            method: str = "accurate", step: float = 1e-4,
-            surface: Surface | None = None) -> tuple[ImpactInputs, ContactLaw, float]:
-    """Validate the inputs of one impact and resolve its force law.
+def _row(fruit, surface, keywords: dict) -> dict:
+    """The one-row table of a ``simulate`` call, every value checked to be a single value."""
+    if fruit is None:
+        fruit = Fruit()
+    elif not isinstance(fruit, Fruit):
+        raise InputError(f"fruit must be a Fruit (or None for the paper's Jonathan apple); got {fruit!r}", "fruit")
+    if surface is None:
+        surface = RIGID_PLANE
+    elif not isinstance(surface, Surface):
+        raise InputError(f"surface must be a Surface (or None for a rigid plane); got {surface!r}", "surface")
+    row = {name: [value] for name, value in asdict(fruit).items() if value is not None}
+    row.update({"surface_" + name: [value] for name, value in asdict(surface).items()})
+    from .registries import REGISTRIES
 
-    Returns (inputs, law, effective radius [m]).  Raises ValueError with the
-    CLI's one-line message on bad input."""
-    fruit = fruit if fruit is not None else Fruit()
-    surface = surface if surface is not None else RIGID_PLANE
-    check_exclusive("velocity", velocity, "drop_height", drop_height)
-    check_exclusive("restitution", restitution, "alpha", alpha)
-    law = get_law(model)
-    cal = get_calibration(calibration)
-    get_solver(method)
-    step = check_positive("step", step, "s")
-    if drop_height is not None:
-        drop_height = check_positive("drop_height", drop_height, "m")
-        velocity = impact_velocity(drop_height)
-    elif velocity is None:
-        velocity = JONATHAN_VELOCITY
-    velocity = check_positive("velocity", velocity, "m/s")
-    if alpha is not None:
-        alpha = check_range("alpha", alpha, 0.0, 1.0 / velocity, low_inclusive=True,
-                            unit="s/m (so that k = 1 - alpha*V_i is in (0, 1])")
-        target = 1.0 - alpha * velocity
-    else:
-        if restitution is None:
-            restitution = JONATHAN_RESTITUTION
-        restitution = check_range("restitution", restitution, 0.0, 1.0, high_inclusive=True)
-        target = restitution
-    stiffness, radius = resolve_stiffness(fruit, surface)
-    if method == "rk4":
-        step = check_range("step", step, 0.0, float(max_rk4_step(fruit.mass, stiffness, velocity)),
-                           high_inclusive=True, unit="s for this impact (at least 20 steps per contact)")
-    factor = float(calibrated_damping_factor(law, cal.name, target, fruit.mass, stiffness, velocity))
-    inputs = ImpactInputs(fruit=fruit, surface=surface, velocity=velocity, drop_height=drop_height,
-                          restitution=restitution, alpha=alpha, model=law.name, calibration=cal.name,
-                          method=method, step=step)
-    force_law = ContactLaw(stiffness=float(law.linear_stiffness(fruit.mass, stiffness, velocity)),
-                           damping_factor=factor, family=law.family, clamp=law.clamp)
-    return inputs, force_law, radius
+    for name, value in keywords.items():
+        if name in REGISTRIES:
+            row[name] = [check_choice(name, value, REGISTRIES[name])]
+        elif value is not None:
+            row[name] = [read_value(name, value)]
+    return row
 
 
 def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, restitution=None,
-             alpha=None, model: str = "hunt-crossley", calibration: str = "exact",
-             method: str = "accurate", step: float = 1e-4, surface: Surface | None = None,
+             alpha=None, damping=None, model: str = INPUTS["model"].default,
+             calibration: str = INPUTS["calibration"].default, method: str = INPUTS["method"].default,
+             step=INPUTS["step"].default, surface: Surface | None = None,
              curve_points: int = 1001) -> ImpactResult:
     """Simulate one impact of ``fruit`` on ``surface``.
 
@@ -347,35 +340,73 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
     drop_height : float, optional
         Drop height h [m], instead of ``velocity``: V_i = sqrt(2 g h).
     restitution : float, optional
-        Restitution coefficient k in (0, 1] (eq 3); default 0.577.
+        Restitution coefficient e in (0, 1] (eq 3) the damping is calibrated to;
+        default 0.577.
     alpha : float, optional
-        Hunt–Crossley α [s/m] instead of k: k = 1 - α V_i (eq 6).
+        Hunt–Crossley's α ≥ 0 [s/m] instead of e, for the power-law laws: the damping
+        is λ = 1.5 α k_c (eq 5), whatever the calibration; the restitution follows.
+    damping : float, optional
+        The damping coefficient ≥ 0 instead of e: λ [N·s/m^2.5] of the power-law laws
+        (b [N·s/m] Kelvin–Voigt, K·B [N·s/m^1.5] Kuwabara–Kono, η [N·s/m^1.25] Tsuji).
     model : str
         Damping law, a key of ``models.DAMPING_LAWS`` (``hertz``,
         ``hunt-crossley``, ``chen``, ...).
     calibration : str
-        ``exact`` (default): λ such that the simulated restitution equals k;
+        ``exact`` (default): the damping such that the simulated restitution equals e;
         ``paper``: the law's published formula (eq 6 with eq 5, or eq 21).
     method : str
         ``accurate`` (default, exact end of contact) or ``rk4`` (the paper's
-        fixed-step integration at ``step`` [s]).
+        fixed-step integration at ``step`` [s], checked against ``accurate``).
+    step : float
+        RK4 time step [s] (default 1e-4 s, the paper's).
     surface : Surface, optional
         Default rigid plane.
     curve_points : int
         Samples of the ``accurate`` curves over [0, T].
 
+    Numbers may be given as strings with units (``velocity="2 m/s"``).
+
     Returns
     -------
     ImpactResult
-        ``success`` is False (with a message) if the solver failed; inputs
-        that are out of range raise ``ValueError`` instead.
+        ``status`` is not ok (with a message saying what and by how much) when the
+        solver failed or missed its accuracy; inputs out of range raise ``ValueError``
+        (an ``InputError`` naming the argument) instead.
     """
-    inputs, law, radius = prepare(fruit, velocity=velocity, drop_height=drop_height,
-                                  restitution=restitution, alpha=alpha, model=model,
-                                  calibration=calibration, method=method, step=step, surface=surface)
-    solver = get_solver(method)
-    values, success, message = solver.characteristics(law, inputs.fruit.mass, inputs.velocity, radius, step)
-    closed = solver.closed_forms(law, inputs.fruit.mass, inputs.velocity)
-    characteristics = Characteristics(*values, *closed)
-    return ImpactResult(inputs=inputs, law=law, characteristics=characteristics, success=success,
-                        message=message, curve_points=curve_points)
+    from .batch import evaluate_inputs
+    from .inputs import read_columns
+
+    keywords = dict(velocity=velocity, drop_height=drop_height, restitution=restitution, alpha=alpha,
+                    damping=damping, model=model, calibration=calibration, method=method, step=step)
+    row = _row(fruit, surface, keywords)
+    inputs, messages = read_columns(row)
+    result = evaluate_inputs(inputs, messages, detail=True, closed_forms=True)
+    code = int(result.status[0])
+    if STATUS_NAMES[code] == "invalid":
+        raise InputError(messages.text(0), messages.argument(0))
+    columns = {name: array[0] for name, array in result.columns.items()}  # Labels give the label
+    fruit_used = Fruit(**{name: columns[name] for name in ("mass", "diameter", "modulus", "poisson")},
+                       stiffness=row["stiffness"][0] if "stiffness" in row else None)
+    surface_used = surface if surface is not None else RIGID_PLANE
+    given = {name: (row[name][0] if name in row else None) for name in ("restitution", "alpha", "damping")}
+    target = float(columns["target_restitution"])
+    inputs_used = ImpactInputs(fruit=fruit_used, surface=surface_used, velocity=float(columns["velocity"]),
+                               drop_height=row["drop_height"][0] if "drop_height" in row else None,
+                               restitution=given["restitution"], alpha=given["alpha"], model=columns["model"],
+                               calibration=columns["calibration"], method=columns["method"],
+                               step=float(columns["step"]), damping=given["damping"],
+                               target_restitution=target if math.isfinite(target) else None)
+    from .models import get_law
+
+    law = get_law(inputs_used.model)
+    contact_law = ContactLaw(stiffness=float(columns["law_stiffness"]), damping_factor=float(columns["damping_factor"]),
+                             family=law.family, clamp=law.clamp)
+    from .engine.powerlaw import CHARACTERISTIC_COLUMNS
+
+    characteristics = Characteristics(**{name: float(columns[name]) for name in CHARACTERISTIC_COLUMNS},
+                                      max_deflection_closed_form=float(result.closed_forms[0, 0]),
+                                      restitution_closed_form=float(result.closed_forms[0, 1]))
+    message = messages.text(0) or "ok"
+    return ImpactResult(inputs=inputs_used, law=contact_law, characteristics=characteristics,
+                        status=STATUS_NAMES[code], message=message, warnings=tuple(result.warnings.row(0)),
+                        curve_points=curve_points)

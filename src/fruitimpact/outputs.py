@@ -83,6 +83,24 @@ def check_folder(folder, argument: str, path=None) -> Path:
     return folder
 
 
+def check_output_folder(folder, argument: str, create: bool = False) -> Path:
+    """A folder to write files into: an existing writable folder, or one that can be made
+    (its nearest existing ancestor is a writable folder).  With ``create`` it is made."""
+    folder = Path(folder)
+    if folder.exists():
+        return check_folder(folder, argument)
+    ancestor = folder.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    check_folder(ancestor, argument, folder)
+    if create:
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise output_error(argument, folder, _reason(exc, ancestor)) from None
+    return folder
+
+
 def check_output(path, argument: str, formats: dict[str, str] | None = None) -> Path:
     """Check that ``path`` can be written, before any work is done.
 
@@ -103,14 +121,18 @@ def check_output(path, argument: str, formats: dict[str, str] | None = None) -> 
     path = Path(path)
     if formats is not None:
         output_format(path, argument, formats)
-    if path.is_dir():
-        raise output_error(argument, path, "it is a folder; give a file name")
     folder = path.parent
-    check_folder(folder, argument, path)
-    limit = _name_max(folder)
+    limit = _name_max(folder if folder.is_dir() else Path("."))
     if len(path.name.encode()) + _TMP_ROOM > limit:
         raise output_error(argument, path, f"the file name is longer than this file system allows "
                                            f"({limit} bytes, with room for a temporary suffix)")
+    try:
+        is_folder = path.is_dir()
+    except OSError as exc:
+        raise output_error(argument, path, _reason(exc, folder)) from None
+    if is_folder:
+        raise output_error(argument, path, "it is a folder; give a file name")
+    check_folder(folder, argument, path)
     if path.exists() and not os.access(path, os.W_OK):
         raise output_error(argument, path, "the file exists and is read-only")
     return path
@@ -198,4 +220,5 @@ def remove_stale_temporaries(path) -> int:
 
 
 __all__ = ["CSV_FORMAT", "FIGURE_FORMATS", "TABLE_FORMATS", "atomic_write", "check_folder", "check_output",
+           "check_output_folder",
            "output_error", "output_format", "remove_stale_temporaries", "stale_temporaries", "temporary_path"]

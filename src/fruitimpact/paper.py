@@ -150,12 +150,9 @@ def worked_example() -> dict:
     for label, (velocity, lam) in scenarios.items():
         fruit = Fruit(mass=PAPER_MASS, diameter=PAPER_DIAMETER, modulus=3e6, poisson=PAPER_POISSON,
                       stiffness=printed_k_c)
-        # the damping is given as λ directly: α = λ/(1.5 k_c) with the Hunt–Crossley paper calibration
-        alpha_equiv = lam / (1.5 * printed_k_c)
-        rk4 = simulate(fruit, velocity=velocity, alpha=alpha_equiv, model="hunt-crossley",
-                       calibration="paper", method="rk4", step=PAPER_STEP)
-        acc = simulate(fruit, velocity=velocity, alpha=alpha_equiv, model="hunt-crossley",
-                       calibration="paper", method="accurate")
+        # the damping is given as λ directly (eq 26's coefficient)
+        rk4 = simulate(fruit, velocity=velocity, damping=lam, model="hunt-crossley", method="rk4", step=PAPER_STEP)
+        acc = simulate(fruit, velocity=velocity, damping=lam, model="hunt-crossley", method="accurate")
         grid = paper_readoff(rk4)
         t_first = grid["T"] + PAPER_STEP  # first grid time with δ ≤ 0, as read off the δ(t) plot
         runs[label] = dict(
@@ -276,22 +273,24 @@ def format_paper_report(report: dict) -> str:
 
 def write_paper_figures(directory) -> list[str]:
     """The worked example's four-panel figures (as stated, and at V_i = 0.8 m/s),
-    overlaying the paper's RK4 grid and the accurate solution."""
+    overlaying the paper's RK4 grid, the accurate solution of the same λ = 1.5 α k_c
+    (eq 5), and the accurate solution calibrated exactly to k = 1 − α V_i (eq 6)."""
     from pathlib import Path
 
+    from .outputs import check_output_folder
     from .plotting import impact_figure, save_figure
 
-    out = Path(directory)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_folder(directory, "directory", create=True)
     fruit = Fruit(mass=PAPER_MASS, diameter=PAPER_DIAMETER, modulus=3e6, poisson=PAPER_POISSON, stiffness=0.835e6)
     written = []
     for name, velocity, alpha in (("worked_example_stated", 1.0, 0.423),
                                   ("worked_example_printed_coefficients_0.8ms", 0.8, 0.438e6 / (1.5 * 0.835e6))):
         results = {
-            "paper's method (RK4, 1e-4 s)": simulate(fruit, velocity=velocity, alpha=alpha, calibration="paper",
-                                                      method="rk4", step=PAPER_STEP),
-            "accurate, paper calibration": simulate(fruit, velocity=velocity, alpha=alpha, calibration="paper"),
-            "accurate, exact calibration": simulate(fruit, velocity=velocity, alpha=alpha, calibration="exact"),
+            "paper's method (RK4, 1e-4 s)": simulate(fruit, velocity=velocity, alpha=alpha, method="rk4",
+                                                      step=PAPER_STEP),
+            "accurate, λ = 1.5 α k_c (eq 5)": simulate(fruit, velocity=velocity, alpha=alpha),
+            "accurate, exact calibration to k = 1 - α V_i": simulate(fruit, velocity=velocity,
+                                                                     restitution=1.0 - alpha * velocity),
         }
         path = out / f"{name}.png"
         save_figure(impact_figure(results, title=f"Worked example, V_i = {velocity:g} m/s, α = {alpha:.3f} s/m"), path)

@@ -1,71 +1,253 @@
-"""Named quantities of the output and inputs: label, display unit and scale.
+"""The one table of quantities: every input and output of an impact, once.
 
-One table for every place that shows a characteristic or an input to a person
-(the simulate table, run summaries, axis labels, thresholds)."""
+Each ``Quantity`` says what a value is (name, symbol, label, doc), how it is
+shown (display unit and scale) and read (its dimension in
+``fruitimpact.units``), the range a value must lie in to be accepted
+(``allowed``: outside it the input is refused with one line) and the range
+that is plausible for fruit (``plausible``: outside it the result carries a
+warning), its default, and the CLI option that sets it.  From this table come
+the options of ``fruitimpact simulate``, ``sweep`` and ``population``, the
+columns ``batch.evaluate`` accepts and returns, the validation of inputs,
+the fields of results and every label, unit and axis of the tables and
+figures.  Add a quantity here, and it is an option, a column and a result.
+
+Plausible ranges are for fruit and vegetables handled on packing lines:
+berries of a gram to melons of several kilograms; flesh moduli from ripe
+tomato (~0.1 MPa) to unripe apple and potato (~10–20 MPa); drops from a few
+millimetres to a few metres.  Sources and the reasoning are in
+docs/glossary.md.
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from .units import parse_quantity
+import numpy as np
+
+from .constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY
+from .units import SI_UNIT, parse_quantity
+
+
+@dataclass(frozen=True)
+class Range:
+    """An interval of accepted (or plausible) values [SI]."""
+
+    low: float = -math.inf
+    high: float = math.inf
+    low_inclusive: bool = False
+    high_inclusive: bool = False
+
+    def contains(self, values):
+        """Boolean mask of ``values`` inside the interval (NaN is outside)."""
+        values = np.asarray(values, dtype=float)
+        above = values >= self.low if self.low_inclusive else values > self.low  # NaN compares False: outside
+        below = values <= self.high if self.high_inclusive else values < self.high
+        return above & below
+
+    def describe(self, unit: str = "") -> str:
+        """``(0, 1]``, ``> 0 kg``, ``>= 0 s/m`` …, for messages."""
+        unit = f" {unit}" if unit else ""
+        if self.high == math.inf and not self.high_inclusive:
+            return f"{'>=' if self.low_inclusive else '>'} {self.low:g}{unit}"
+        left = "[" if self.low_inclusive else "("
+        right = "]" if self.high_inclusive else ")"
+        return f"in {left}{self.low:g}, {self.high:g}{right}{unit}"
+
+
+POSITIVE = Range(0.0, math.inf)
+NON_NEGATIVE = Range(0.0, math.inf, low_inclusive=True)
+#: Positive, infinity allowed (a rigid or flat surface).
+POSITIVE_OR_INFINITE = Range(0.0, math.inf, high_inclusive=True)
 
 
 @dataclass(frozen=True)
 class Quantity:
-    """A column of the output: label, display unit and scale, and units accepted in thresholds."""
+    """One named quantity of the table.
+
+    Attributes
+    ----------
+    name : str
+        Keyword, column and JSON key (``peak_force``).
+    symbol : str
+        The paper's symbol (``F_max``).
+    label : str
+        Words and symbol for tables and axes (``peak force F_max``).
+    dimension : str
+        Key of ``fruitimpact.units.UNITS``: how values with units are read.
+    unit : str
+        Display unit of tables and figures.
+    scale : float
+        Display value = SI value × scale.
+    doc : str
+        One line of meaning.
+    allowed : Range or None
+        Inputs: values outside are refused.
+    plausible : Range or None
+        Inputs: values outside are accepted with a warning.
+    default : float or str or None
+        Inputs: the value when not given (None: optional, no default).
+    option : str or None
+        Inputs: the CLI option (a contract: never renamed).
+    choices : str or None
+        Text inputs: the registry whose names are allowed (``model`` …).
+    """
 
     name: str
+    symbol: str
     label: str
-    unit: str  # display unit
-    scale: float  # display value = SI value * scale
-    si_unit: str
-    dimension: str  # a key of fruitimpact.units.UNITS, for parsing values
+    dimension: str
+    unit: str
+    scale: float
+    doc: str
+    allowed: Range | None = None
+    plausible: Range | None = None
+    default: float | str | None = None
+    option: str | None = None
+    choices: str | None = None
+
+    @property
+    def si_unit(self) -> str:
+        return SI_UNIT.get(self.dimension, "")
+
+    @property
+    def numeric(self) -> bool:
+        return self.choices is None
 
     @property
     def axis_label(self) -> str:
         return f"{self.label} [{self.unit}]" if self.unit else self.label
 
-    def parse(self, text: str) -> float:
+    def parse(self, text) -> float:
         """A value of this quantity (plain number = SI, or with a unit) → SI."""
         return parse_quantity(text, self.dimension)
 
+    def display(self, value: float) -> str:
+        """``value`` [SI] in display units, e.g. ``180 g``."""
+        return f"{value * self.scale:.6g} {self.unit}".rstrip()
 
-def _q(name, label, unit, scale, si_unit, dimension):
-    return name, Quantity(name, label, unit, scale, si_unit, dimension)
+
+def _table(*quantities: Quantity) -> dict[str, Quantity]:
+    return {q.name: q for q in quantities}
 
 
-#: Characteristics (and law columns) of the output: what can be summarised, plotted, thresholded.
-CHARACTERISTICS = dict((
-    _q("peak_force", "peak force F_max", "N", 1.0, "N", "force"),
-    _q("time_to_peak", "time to peak t_c", "ms", 1e3, "s", "time"),
-    _q("contact_duration", "contact duration T", "ms", 1e3, "s", "time"),
-    _q("max_deflection", "max deflection δ_max", "mm", 1e3, "m", "length"),
-    _q("time_to_max_deflection", "time to max deflection", "ms", 1e3, "s", "time"),
-    _q("exit_velocity", "exit velocity", "m/s", 1.0, "m/s", "velocity"),
-    _q("restitution", "restitution e", "", 1.0, "", "dimensionless"),
-    _q("absorbed_energy", "absorbed energy", "mJ", 1e3, "J", "energy"),
-    _q("firmness_c", "firmness C = F_max/t_c", "N/ms", 1e-3, "N/s", "firmness"),
-    _q("firmness_c_star", "firmness C* = F_max/t_c²", "N/ms²", 1e-6, "N/s²", "firmness_star"),
-    _q("max_pressure", "max contact pressure p_0", "MPa", 1e-6, "Pa", "modulus"),
-    _q("contact_radius", "contact radius a", "mm", 1e3, "m", "length"),
-    _q("law_stiffness", "contact stiffness k_c", "N/m^1.5", 1.0, "N/m^1.5", "stiffness"),
-    _q("damping", "damping λ", "N·s/m^2.5", 1.0, "N·s/m^2.5", "damping"),
-    _q("damping_factor", "damping factor c = λ/k_c", "s/m", 1.0, "s/m", "alpha"),
-    _q("target_restitution", "target restitution k", "", 1.0, "", "dimensionless"),
-))
-#: The characteristics proper (summarised by default), in the engine's column order.
-DEFAULT_SUMMARY = tuple(list(CHARACTERISTICS)[:12])
+_JONATHAN = "(default: the paper's Jonathan apple)"
 
-#: Numeric inputs: dimension and axis label of each (columns of batch.evaluate).
-INPUTS = dict((
-    _q("mass", "mass M", "g", 1e3, "kg", "mass"),
-    _q("diameter", "diameter d", "mm", 1e3, "m", "length"),
-    _q("modulus", "Young's modulus E", "MPa", 1e-6, "Pa", "modulus"),
-    _q("poisson", "Poisson's ratio ν", "", 1.0, "", "dimensionless"),
-    _q("stiffness", "contact stiffness k_c", "N/m^1.5", 1.0, "N/m^1.5", "stiffness"),
-    _q("velocity", "impact velocity V_i", "m/s", 1.0, "m/s", "velocity"),
-    _q("drop_height", "drop height h", "cm", 1e2, "m", "length"),
-    _q("restitution", "restitution k", "", 1.0, "", "dimensionless"),
-    _q("alpha", "Hunt–Crossley α", "s/m", 1.0, "s/m", "alpha"),
-    _q("step", "RK4 step", "ms", 1e3, "s", "time"),
-))
+#: Inputs of one impact: keywords of ``simulate``, columns of ``batch.evaluate``,
+#: options of ``simulate``/``sweep``/``population``.  Numeric inputs first, then text.
+INPUTS: dict[str, Quantity] = _table(
+    Quantity("mass", "M", "mass M", "mass", "g", 1e3, f"fruit mass {_JONATHAN}",
+             POSITIVE, Range(1e-3, 20.0, True, True), JONATHAN_APPLE["mass"], "--mass"),
+    Quantity("diameter", "d", "diameter d", "length", "mm", 1e3,
+             f"fruit diameter; the local contact radius is d/2 {_JONATHAN}",
+             POSITIVE, Range(5e-3, 0.4, True, True), JONATHAN_APPLE["diameter"], "--diameter"),
+    Quantity("modulus", "E", "Young's modulus E", "modulus", "MPa", 1e-6,
+             f"Young's modulus of the flesh {_JONATHAN}",
+             POSITIVE, Range(2e4, 1e8, True, True), JONATHAN_APPLE["modulus"], "--modulus"),
+    Quantity("poisson", "ν", "Poisson's ratio ν", "dimensionless", "", 1.0,
+             f"Poisson's ratio of the flesh {_JONATHAN}",
+             Range(-1.0, 0.5), Range(0.1, 0.5, True, False), JONATHAN_APPLE["poisson"], "--poisson"),
+    Quantity("stiffness", "k_c", "contact stiffness k_c", "stiffness", "N/m^1.5", 1.0,
+             "contact stiffness given directly; overrides the Hertz value from E, ν, d (eq 9)",
+             POSITIVE, None, None, "--stiffness"),
+    Quantity("velocity", "V_i", "impact velocity V_i", "velocity", "m/s", 1.0,
+             "impact velocity (default 1 m/s)",
+             POSITIVE, Range(0.01, 15.0, True, True), None, "--velocity"),
+    Quantity("drop_height", "h", "drop height h", "length", "cm", 1e2,
+             "drop height instead of the velocity: V_i = sqrt(2 g h)",
+             POSITIVE, Range(1e-3, 10.0, True, True), None, "--drop-height"),
+    Quantity("restitution", "e", "restitution e", "dimensionless", "", 1.0,
+             "restitution coefficient the damping is calibrated to (eq 3; default 0.577)",
+             Range(0.0, 1.0, high_inclusive=True), None, None, "--restitution"),
+    Quantity("alpha", "α", "Hunt–Crossley α", "alpha", "s/m", 1.0,
+             "Hunt–Crossley damping parameter instead of e: λ = 1.5 α k_c (eq 5); power-law laws only",
+             NON_NEGATIVE, None, None, "--alpha"),
+    Quantity("damping", "λ", "damping λ", "damping", "N·s/m^2.5", 1.0,
+             "damping coefficient given directly instead of e: λ of F = k_c δ^1.5 + λ δ^1.5 δ̇ "
+             "(b [N·s/m] for kelvin-voigt, K·B [N·s/m^1.5] for kuwabara-kono, η [N·s/m^1.25] for tsuji)",
+             NON_NEGATIVE, None, None, "--damping"),
+    Quantity("surface_modulus", "E_2", "surface modulus E_2", "modulus", "MPa", 1e-6,
+             "Young's modulus of the surface (default inf: rigid)",
+             POSITIVE_OR_INFINITE, None, math.inf, "--surface-modulus"),
+    Quantity("surface_poisson", "ν_2", "surface Poisson's ratio ν_2", "dimensionless", "", 1.0,
+             "Poisson's ratio of the surface (default 0.3; no effect on a rigid surface)",
+             Range(-1.0, 0.5), None, 0.3, "--surface-poisson"),
+    Quantity("surface_radius", "R_2", "surface radius R_2", "length", "mm", 1e3,
+             "radius of curvature of the surface (default inf: flat)",
+             POSITIVE_OR_INFINITE, None, math.inf, "--surface-radius"),
+    Quantity("step", "Δt", "RK4 step Δt", "time", "ms", 1e3, "RK4 time step (default 1e-4 s, the paper's)",
+             POSITIVE, None, 1e-4, "--step"),
+    Quantity("model", "", "damping law", "text", "", 1.0, "damping law (fruitimpact models)",
+             default="hunt-crossley", option="--model", choices="model"),
+    Quantity("calibration", "", "calibration", "text", "", 1.0,
+             "exact: the damping gives exactly the requested e; paper: the law's published formula",
+             default="exact", option="--calibration", choices="calibration"),
+    Quantity("method", "", "method", "text", "", 1.0,
+             "accurate (exact) or rk4 (the paper's fixed-step method)",
+             default="accurate", option="--method", choices="method"),
+)
+
+#: Inputs given in several ways: at most one of each group (the first is the default way).
+ALTERNATIVES = (("velocity", "drop_height"), ("restitution", "alpha", "damping"))
+#: Defaults of the optional inputs when no alternative of their group is given.
+GROUP_DEFAULTS = {"velocity": JONATHAN_VELOCITY, "restitution": JONATHAN_RESTITUTION}
+
+NUMERIC_INPUTS = tuple(name for name, q in INPUTS.items() if q.numeric)
+TEXT_INPUTS = tuple(name for name, q in INPUTS.items() if not q.numeric)
+
+
+#: Outputs of one impact (the characteristics, then the contact law as used).
+OUTPUTS: dict[str, Quantity] = _table(
+    Quantity("peak_force", "F_max", "peak force F_max", "force", "N", 1.0, "largest contact force"),
+    Quantity("time_to_peak", "t_c", "time to peak t_c", "time", "ms", 1e3, "time from first touch to F_max"),
+    Quantity("contact_duration", "T", "contact duration T", "time", "ms", 1e3,
+             "time from first touch to separation"),
+    Quantity("max_deflection", "δ_max", "max deflection δ_max", "length", "mm", 1e3,
+             "largest deflection of the fruit at the contact"),
+    Quantity("time_to_max_deflection", "t_m", "time to max deflection", "time", "ms", 1e3,
+             "time from first touch to δ_max"),
+    Quantity("exit_velocity", "V_e", "exit velocity", "velocity", "m/s", 1.0,
+             "rebound speed, away from the surface"),
+    Quantity("restitution", "e", "restitution e", "dimensionless", "", 1.0,
+             "exit speed / impact speed (eq 3), as simulated"),
+    Quantity("absorbed_energy", "W", "absorbed energy", "energy", "mJ", 1e3, "½ m V_i² (1 − e²)"),
+    Quantity("firmness_c", "C", "firmness C = F_max/t_c", "firmness", "N/ms", 1e-3, "F_max / t_c (eqs 1, 28)"),
+    Quantity("firmness_c_star", "C*", "firmness C* = F_max/t_c²", "firmness_star", "N/ms²", 1e-6,
+             "F_max / t_c² (eq 2)"),
+    Quantity("max_pressure", "p_0", "max contact pressure p_0", "modulus", "MPa", 1e-6,
+             "largest Hertz centre pressure 3F/(2π R δ) during the contact"),
+    Quantity("contact_radius", "a", "contact radius a", "length", "mm", 1e3, "Hertz contact radius √(R δ_max)"),
+    Quantity("law_stiffness", "k_c", "contact stiffness k_c", "stiffness", "N/m^1.5", 1.0,
+             "the elastic coefficient the law uses (k [N/m] for kelvin-voigt)"),
+    Quantity("damping", "λ", "damping λ", "damping", "N·s/m^2.5", 1.0,
+             "the coefficient of the law's rate term, as used (λ; b, K·B or η for the other families)"),
+    Quantity("damping_factor", "c", "damping factor c = λ/k_c", "alpha", "s/m", 1.0,
+             "damping / stiffness (s/m for the power-law family)"),
+    Quantity("target_restitution", "e_0", "target restitution", "dimensionless", "", 1.0,
+             "the restitution the damping was calibrated for (NaN when α or λ was given)"),
+)
+
+#: The characteristics proper (the engine's columns, in its order): summarised by default.
+CHARACTERISTIC_NAMES = tuple(list(OUTPUTS)[:12])
+#: Output quantities by name (characteristics and the law columns): what runs summarise and plot.
+CHARACTERISTICS = OUTPUTS
+DEFAULT_SUMMARY = CHARACTERISTIC_NAMES
+
+
+def input_quantity(name: str) -> Quantity:
+    """The input called ``name`` (``-`` read as ``_``); ``ValueError`` naming the known ones."""
+    key = str(name).strip().replace("-", "_")
+    if key not in INPUTS:
+        raise ValueError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})")
+    return INPUTS[key]
+
+
+def option_of(name: str) -> str:
+    """The CLI option of input ``name`` (``drop_height`` → ``--drop-height``)."""
+    quantity = INPUTS.get(name)
+    return quantity.option if quantity is not None and quantity.option else "--" + name.replace("_", "-")
+
+
+__all__ = ["ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY", "GROUP_DEFAULTS",
+           "INPUTS", "NON_NEGATIVE", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
+           "Range", "TEXT_INPUTS", "input_quantity", "option_of"]

@@ -1,28 +1,32 @@
 """Solvers behind one interface: ``accurate`` (exact) and ``rk4`` (the paper's).
 
-Each solver turns a resolved force law, a mass, an impact velocity and an
-effective radius into the characteristics (``engine.powerlaw.CHARACTERISTIC_COLUMNS``)
-and into curves.  Failures come back as ``success = False`` with a message,
-never as an exception in the middle of a sweep.
+A solver turns rows of resolved contact laws (stiffness, damping factor),
+masses, impact velocities and effective radii into the characteristics
+(``engine.powerlaw.CHARACTERISTIC_COLUMNS``), and one impact into curves.
+Each solver states the accuracy it promises (``tolerance``) and whether its
+results are checked against the accurate solver (``checked``), which
+``status.judge`` enforces.  Failures come back as NaN rows, never as an
+exception in the middle of a sweep.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import forces
-from .engine.powerlaw import (N_CHARACTERISTICS, powerlaw_characteristics, powerlaw_curves, powerlaw_single,
-                              r_func, restitution_of_x)
-from .engine.rk4 import rk4_impact
+from .engine.codes import N_CHARACTERISTICS
+
+# The compiled engine is imported inside the functions that run it: the registry
+# (and the command line's --help) must not start numba.
 
 #: Safety limit on RK4 steps for one impact.
 RK4_MAX_STEPS = 2_000_000
 #: Fewest RK4 steps per contact accepted (the step may be at most T_Hertz / this).
 RK4_MIN_STEPS_PER_CONTACT = 20
+#: Relative tolerance of the compiled adaptive integrator (laws without a first integral).
+ADAPTIVE_RTOL = 1e-10
 
 
 def max_rk4_step(mass, stiffness, velocity):
@@ -30,166 +34,173 @@ def max_rk4_step(mass, stiffness, velocity):
     a lower bound of T for the laws here (damping lengthens the contact)."""
     from .contact import hertz_contact_duration
 
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
         return hertz_contact_duration(mass, stiffness, velocity) / RK4_MIN_STEPS_PER_CONTACT
 
 
-def closed_forms(law, mass: float, velocity: float) -> tuple[float, float]:
-    """(δ_max [m], e) from the first integral of F = K δ^n (1 + c δ̇):
+def power_law_closed_forms(stiffness, damping_factor, mass, velocity, exponent: float = 1.5):
+    """(δ_max [m], e) from the first integral of F = K δ^n (1 + c δ̇), arrays:
     δ_max = [(n+1) m (x - ln(1+x)) / (K c²)]^(1/(n+1)), x = c v0, and e the root
     of (1 + x) = (1 - e x) exp((1 + e) x) (Hunt & Crossley 1975; docs/physics.md).
-    NaN for other force families."""
-    if law.family != forces.POWER_LAW:
-        return math.nan, math.nan
-    n = law.exponent
-    x = law.damping_factor * velocity
+    A self-check beside the solvers' numbers, independent of their quadrature."""
+    from .engine.powerlaw import exact_restitution, r_func
+
+    stiffness, damping_factor, mass, velocity = (np.asarray(a, dtype=float) for a in
+                                                 (stiffness, damping_factor, mass, velocity))
+    x = damping_factor * velocity
     # (x - ln(1+x))/c² = v0² r(x), written through r to stay exact as c → 0
-    max_deflection = ((n + 1.0) * mass * velocity ** 2 * r_func(x) / law.stiffness) ** (1.0 / (n + 1.0))
-    return max_deflection, restitution_of_x(x)
+    r = np.vectorize(r_func, otypes=[float])(x)
+    n = exponent
+    max_deflection = ((n + 1.0) * mass * velocity ** 2 * r / stiffness) ** (1.0 / (n + 1.0))
+    return max_deflection, exact_restitution(x)
 
 
-#: Relative tolerance of the compiled adaptive integrator (laws without a first integral).
-ADAPTIVE_RTOL = 1e-10
-
-
-def _accurate_characteristics(law, mass, velocity, radius, step):
-    if law.family == forces.POWER_LAW:
-        values = powerlaw_single(mass, law.stiffness, law.exponent, law.damping_factor, velocity, radius)
-    else:
-        from .engine.adaptive import adaptive_impact
-
-        values = np.empty(N_CHARACTERISTICS)
-        if adaptive_impact(law.family, law.params(), law.clamp, mass, velocity, radius, ADAPTIVE_RTOL, values) < 0:
-            return tuple(float(v) for v in values), False, "adaptive integrator did not reach separation"
-    return _judge(values)
-
-
-#: Characteristics that every completed impact has (peak force, duration, δ_max, e).
-_ESSENTIAL = [0, 2, 3, 6]
-
-
-def _judge(values):
-    """(values, success, message): success needs the essential characteristics
-    finite; a peak at first touch (a dashpot's force jump) leaves C and C*
-    undefined, which is reported, not failed."""
-    values = [float(v) for v in values]
-    if not all(np.isfinite(values[i]) for i in _ESSENTIAL):
-        return tuple(values), False, "solver produced non-finite characteristics"
-    notes = []
-    if values[1] == 0.0:
-        notes.append("peak force at first touch (force jump of the dashpot): C and C* undefined")
-    if np.isinf(values[10]):
-        values[10] = math.nan
-        notes.append("max_pressure undefined: the damping force does not vanish with δ at first touch, "
-                     "so the Hertz pressure 3F/(2πRδ) is unbounded there")
-    return tuple(values), True, "; ".join(notes) or "ok"
-
-
-def _accurate_curves(law, mass, velocity, step, points):
-    values, _, _ = _accurate_characteristics(law, mass, velocity, 1.0, step)
-    times = np.linspace(0.0, values[2], int(points))
-    if law.family == forces.POWER_LAW:
-        deflection, rate, force, _ = powerlaw_curves(mass, law.stiffness, law.damping_factor, velocity,
-                                                     times, law.exponent)
-    else:
-        from .engine.adaptive import adaptive_curves
-
-        deflection, rate, force, _ = adaptive_curves(law.family, law.params(), law.clamp, mass, velocity, times)
-    return times, deflection, rate, force
-
-
-def _rk4_run(law, mass, velocity, radius, step, store):
-    # the contact lasts a few Hertz times; the step limit only guards runaway input
-    max_steps = RK4_MAX_STEPS
-    size = max_steps + 2 if store else 1
-    if store:
-        estimate = 40.0 * ((1.25 * mass * velocity ** 2 / law.stiffness) ** 0.4 / velocity) / step
-        size = int(min(max_steps, max(estimate, 1000))) + 2
-        max_steps = size - 2
-    arrays = [np.empty(size) for _ in range(4)]
-    out = np.empty(N_CHARACTERISTICS)
-    count = rk4_impact(law.family, law.params(), law.clamp, mass, velocity, radius, step,
-                       max_steps, store, *arrays, out)
-    return count, arrays, out
-
-
-def _rk4_characteristics(law, mass, velocity, radius, step):
-    count, _, out = _rk4_run(law, mass, velocity, radius, step, False)
-    if count < 0:
-        return tuple(out), False, f"rk4: contact did not end within {RK4_MAX_STEPS} steps of {step:g} s"
-    return _judge(out)
-
-
-def _rk4_curves(law, mass, velocity, step, points):
-    count, (t, d, v, f), _ = _rk4_run(law, mass, velocity, 1.0, step, True)
-    if count < 0:
-        raise RuntimeError(f"rk4: contact did not end within the step limit at step {step:g} s")
-    return t[:count].copy(), d[:count].copy(), v[:count].copy(), f[:count].copy()
-
-
-def judge_batch(out: np.ndarray) -> np.ndarray:
-    """Rows of a characteristics array that completed (as ``_judge``); an unbounded
-    Hertz pressure at first touch is set to NaN in place."""
-    out[np.isinf(out[:, 10]), 10] = np.nan
-    return np.all(np.isfinite(out[:, _ESSENTIAL]), axis=1)
-
-
-def _accurate_batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
-    if family == forces.POWER_LAW:
-        return powerlaw_characteristics(mass, stiffness, damping_factor, velocity, radius, tabulated=tabulated)
+def _accurate_batch(law, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
     from .calibrate import law_params
+    from .engine.powerlaw import powerlaw_characteristics
+
+    if law.force_family.first_integral:
+        return powerlaw_characteristics(mass, stiffness, damping_factor, velocity, radius, tabulated=tabulated)
     from .engine.adaptive import adaptive_characteristics
 
     rows = len(mass)
-    return adaptive_characteristics(np.full(rows, family), law_params(family, stiffness, damping_factor),
-                                    np.full(rows, clamp), mass, velocity, radius, ADAPTIVE_RTOL)
+    return adaptive_characteristics(np.full(rows, law.family), law_params(law.family, stiffness, damping_factor),
+                                    np.full(rows, law.clamp), mass, velocity, radius, ADAPTIVE_RTOL)
 
 
-def _rk4_batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
+def _rk4_batch(law, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
     from .calibrate import law_params
-    from .engine.rk4 import rk4_batch
+    from .engine.powerlaw import PARALLEL_MIN_ROWS
+    from .engine.rk4 import rk4_batch, rk4_batch_serial
 
     rows = len(mass)
     out = np.empty((rows, N_CHARACTERISTICS))
-    rk4_batch(np.full(rows, family, dtype=np.int64), law_params(family, stiffness, damping_factor),
-              np.full(rows, clamp), mass, velocity, radius, np.broadcast_to(step, (rows,)).astype(float),
-              RK4_MAX_STEPS, out)
+    kernel = rk4_batch if rows > PARALLEL_MIN_ROWS // 20 else rk4_batch_serial
+    kernel(np.full(rows, law.family, dtype=np.int64), law_params(law.family, stiffness, damping_factor),
+           np.full(rows, law.clamp), np.ascontiguousarray(mass, dtype=float),
+           np.ascontiguousarray(velocity, dtype=float), np.ascontiguousarray(radius, dtype=float),
+           np.ascontiguousarray(np.broadcast_to(step, (rows,)), dtype=float), RK4_MAX_STEPS, out)
     return out
+
+
+def _accurate_curves(law, stiffness, damping_factor, mass, velocity, step, times):
+    """δ, δ̇, F of rows of impacts at ``times`` (rows, points): the exact phase curve, or
+    the adaptive integrator's dense output."""
+    from .calibrate import law_params
+
+    if law.force_family.first_integral:
+        from .engine.powerlaw import powerlaw_curves_batch
+
+        return powerlaw_curves_batch(mass, stiffness, damping_factor, velocity, times)
+    from .engine.adaptive import adaptive_curves
+
+    params = law_params(law.family, stiffness, damping_factor)
+    out = [np.empty(times.shape) for _ in range(3)]
+    for i in range(times.shape[0]):
+        d, v, f, _ = adaptive_curves(law.family, params[i], law.clamp, mass[i], velocity[i], times[i])
+        out[0][i], out[1][i], out[2][i] = d, v, f
+    return tuple(out)
+
+
+def _accurate_samples(law, stiffness, damping_factor, mass, velocity, step, points, duration):
+    """(t, δ, δ̇, F) of one impact at ``points`` evenly spaced times over [0, T]."""
+    times = np.linspace(0.0, duration, int(points))
+    curves = _accurate_curves(law, *(np.atleast_1d(float(a)) for a in (stiffness, damping_factor, mass, velocity)),
+                              step, times[None, :])
+    return (times, *(c[0] for c in curves))
+
+
+def _rk4_samples(law, stiffness, damping_factor, mass, velocity, step, points=None, duration=None):
+    """The RK4 grid of one impact: (t, δ, δ̇, F), the last sample at the interpolated
+    separation.  ``ValueError`` if the contact does not end within ``RK4_MAX_STEPS``."""
+    from .calibrate import law_params
+    from .engine.rk4 import rk4_impact
+
+    estimate = 40.0 * ((1.25 * mass * velocity ** 2 / stiffness) ** 0.4 / velocity) / step
+    size = int(min(RK4_MAX_STEPS, max(estimate, 1000))) + 2
+    arrays = [np.empty(size) for _ in range(4)]
+    out = np.empty(N_CHARACTERISTICS)
+    params = law_params(law.family, stiffness, damping_factor)
+    count = rk4_impact(law.family, params, law.clamp, mass, velocity, 1.0, step, size - 2, True, *arrays, out)
+    if count < 0:
+        raise ValueError(f"rk4: the contact did not end within {size - 2} steps of {step:g} s")
+    return tuple(a[:count].copy() for a in arrays)
+
+
+def _rk4_curves(law, stiffness, damping_factor, mass, velocity, step, times):
+    """δ, δ̇, F of rows of impacts at ``times`` (rows, points): cubic Hermite interpolation
+    of each row's RK4 grid (δ with δ̇ as its slope, δ̇ with -F/m), and the law's force at
+    the interpolated state; after separation the separation state with F = 0."""
+    from .calibrate import law_params
+    from .engine.forces import contact_force
+
+    step = np.broadcast_to(step, np.shape(mass))
+    out = [np.empty(times.shape) for _ in range(3)]
+    params = law_params(law.family, stiffness, damping_factor)
+    for i in range(times.shape[0]):
+        t, d, v, _ = _rk4_samples(law, stiffness[i], damping_factor[i], mass[i], velocity[i], step[i])
+        accel = np.array([-contact_force(law.family, params[i], di, vi, law.clamp) / mass[i] for di, vi in zip(d, v)])
+        clipped = np.clip(times[i], t[0], t[-1])
+        index = np.clip(np.searchsorted(t, clipped, side="right") - 1, 0, len(t) - 2)
+        h = t[index + 1] - t[index]
+        s = np.where(h > 0, (clipped - t[index]) / np.where(h > 0, h, 1.0), 0.0)
+        h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
+        h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
+        deflection = np.maximum(h00 * d[index] + h10 * h * v[index] + h01 * d[index + 1] + h11 * h * v[index + 1], 0)
+        rate = h00 * v[index] + h10 * h * accel[index] + h01 * v[index + 1] + h11 * h * accel[index + 1]
+        force = np.array([contact_force(law.family, params[i], di, vi, law.clamp) for di, vi in zip(deflection, rate)])
+        force[times[i] >= t[-1]] = 0.0
+        out[0][i], out[1][i], out[2][i] = deflection, rate, force
+    return tuple(out)
 
 
 @dataclass(frozen=True)
 class Solver:
-    """A way to integrate impacts, one or many.
+    """A way to integrate impacts.
 
-    characteristics(law, mass, velocity, radius, step) -> (values, success, message)
-    curves(law, mass, velocity, step, points) -> (t, δ, δ̇, F)
-    batch(family, clamp, stiffness, damping_factor, mass, velocity, radius, step, tabulated) -> (rows, 12)
+    batch(law, stiffness, damping_factor, mass, velocity, radius, step, tabulated) -> (rows, 12)
+        characteristics of rows of one damping law (arrays; serial kernels for a few rows);
+    curves(law, stiffness, damping_factor, mass, velocity, step, times) -> (δ, δ̇, F)
+        rows of impacts (arrays) at ``times`` [s], shape (rows, points);
+    samples(law, stiffness, damping_factor, mass, velocity, step, points, duration) -> (t, δ, δ̇, F)
+        one impact on the solver's own grid (``points`` over [0, T], or the RK4 steps).
+    tolerance : float
+        The accuracy it promises: relative on F_max, T, δ_max and absolute on e.
+    checked : bool
+        Its results are compared with the accurate solver's (``status.judge``).
     """
 
     name: str
     description: str
-    characteristics: Callable
-    curves: Callable
     batch: Callable
-    closed_forms: Callable = closed_forms
+    curves: Callable
+    samples: Callable
+    tolerance: float
+    checked: bool = False
 
 
 SOLVERS: dict[str, Solver] = {
     "accurate": Solver(
         name="accurate",
         description=("exact: characteristics from the first integral and Gauss-Jacobi quadrature of the "
-                     "contact time; curves by exact inversion of t(δ̇) (agrees with closed forms to ~1e-12)"),
-        characteristics=_accurate_characteristics,
-        curves=_accurate_curves,
+                     "contact time, or compiled DOP853 with exact event location for the laws without a first "
+                     "integral; curves by exact inversion of t(δ̇) or dense output (agrees with closed forms to "
+                     "~1e-12)"),
         batch=_accurate_batch,
+        curves=_accurate_curves,
+        samples=_accurate_samples,
+        tolerance=1e-8,
     ),
     "rk4": Solver(
         name="rk4",
         description=("the paper's method: classical Runge-Kutta at a fixed step; peaks are grid samples, the "
-                     "end of contact is interpolated inside the last step"),
-        characteristics=_rk4_characteristics,
-        curves=_rk4_curves,
+                     "end of contact is interpolated inside the last step; checked against the accurate solver "
+                     "(1 % on e, T, δ_max and F_max; t_c is a grid sample, good to one step)"),
         batch=_rk4_batch,
+        curves=_rk4_curves,
+        samples=_rk4_samples,
+        tolerance=1e-2,
+        checked=True,
     ),
 }
 
@@ -198,5 +209,9 @@ def get_solver(name: str) -> Solver:
     """The solver registered as ``name``; ValueError naming the choices otherwise."""
     try:
         return SOLVERS[name]
-    except KeyError:
+    except (KeyError, TypeError):
         raise ValueError(f"method must be one of {', '.join(SOLVERS)}; got {name!r}") from None
+
+
+__all__ = ["ADAPTIVE_RTOL", "RK4_MAX_STEPS", "RK4_MIN_STEPS_PER_CONTACT", "SOLVERS", "Solver", "power_law_closed_forms",
+           "get_solver", "max_rk4_step"]

@@ -1,50 +1,191 @@
-"""Checks at the boundary.  Each raises ``ValueError`` with one line that names
-the argument and its allowed range; the CLI prints the same line."""
+"""Checks at the boundary, driven by the table of quantities.
+
+One path for one value and for a column of a million: ``check_value`` (a
+``Fruit`` field, a keyword of ``simulate``) and ``out_of_range`` (a column
+of ``batch.evaluate``) use the same ``Quantity.allowed`` range and the same
+words (``range_message``).  A refused input raises ``InputError``, a
+``ValueError`` that carries the name of the argument it is about, so that
+the CLI can name the option without reading the message.
+
+Per-row outcomes of a batch are kept as small integer codes with one text
+per distinct message (``MessageBook``) and bit masks of warnings
+(``WarningBook``): a million rows do not cost a million strings.
+"""
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 
-def _as_float(name: str, value) -> float:
+from .quantities import INPUTS, Quantity, Range
+from .units import UNITS, parse_quantity
+
+
+class InputError(ValueError):
+    """A refused input: one line (``str(error)``) and the ``argument`` it is about
+    (an input name such as ``mass``, or None when it concerns several)."""
+
+    def __init__(self, message: str, argument: str | None = None):
+        super().__init__(message)
+        self.argument = argument
+
+
+def range_message(quantity: Quantity, allowed: Range | None = None) -> str:
+    """``mass must be a finite number > 0 kg``, ``poisson must be in (-1, 0.5)`` …"""
+    allowed = allowed or quantity.allowed
+    unit = quantity.si_unit
+    text = allowed.describe(unit)
+    if allowed.high == math.inf and not allowed.high_inclusive:
+        return f"{quantity.name} must be a finite number {text}"
+    if allowed.high == math.inf:
+        return f"{quantity.name} must be a number {text} (inf allowed)"
+    return f"{quantity.name} must be {text}"
+
+
+def unreadable_message(quantity: Quantity, text) -> str:
+    """The refusal of a cell or value that is not a number with a unit of ``quantity``."""
+    units = ", ".join(u for u in UNITS[quantity.dimension] if u)
+    plain = quantity.si_unit or "dimensionless"
+    allowed = f"units allowed: {units}; a plain number is {plain}" if units else "a plain number, no unit"
+    return f"{quantity.name} must be a number ({allowed}); got {text!r}"
+
+
+def nan_message(quantity: Quantity) -> str:
+    """A NaN is a value, never a request for the default."""
+    must = range_message(quantity).split(" ", 1)[1]
+    return (f"{quantity.name} is NaN; it {must} (leave it out to take the default: an empty CSV cell, "
+            f"None or pd.NA)")
+
+
+def read_value(name: str, value) -> float:
+    """``value`` of input ``name`` as a float [SI]: numbers as they are, strings with
+    units parsed (``"115g"``).  ``InputError`` if it is not a number."""
+    quantity = INPUTS[name]
+    if isinstance(value, bool):
+        raise InputError(unreadable_message(quantity, value), name)
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return float(value)
+    if isinstance(value, str):
+        try:
+            return parse_quantity(value, quantity.dimension)
+        except ValueError:
+            raise InputError(unreadable_message(quantity, value), name) from None
     try:
         return float(value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number; got {value!r}") from None
+        raise InputError(unreadable_message(quantity, value), name) from None
 
 
-def positive_message(name: str, unit: str = "") -> str:
-    """The wording of a refused positive quantity (also used per row by ``batch``)."""
-    return f"{name} must be a finite number > 0{(' ' + unit) if unit else ''}"
-
-
-def range_message(name: str, low: float, high: float, low_inclusive: bool = False,
-                  high_inclusive: bool = False, unit: str = "") -> str:
-    """The wording of a value outside its interval (also used per row by ``batch``)."""
-    interval = f"{'[' if low_inclusive else '('}{low:g}, {high:g}{']' if high_inclusive else ')'}"
-    return f"{name} must be in {interval}{(' ' + unit) if unit else ''}"
-
-
-def check_positive(name: str, value, unit: str = "") -> float:
-    """``value`` as float if finite and > 0."""
-    number = _as_float(name, value)
-    if not (math.isfinite(number) and number > 0.0):
-        raise ValueError(f"{positive_message(name, unit)}; got {value!r}")
+def check_value(name: str, value) -> float:
+    """Input ``name`` read (``read_value``) and checked against its allowed range;
+    ``InputError`` with the one-line message (the same as a batch row's) otherwise."""
+    quantity = INPUTS[name]
+    number = read_value(name, value)
+    if math.isnan(number):
+        raise InputError(f"{nan_message(quantity)}; got {number!r}", name)
+    if not quantity.allowed.contains(number):
+        raise InputError(f"{range_message(quantity)}; got {number!r}", name)
     return number
 
 
-def check_range(name: str, value, low: float, high: float, *, low_inclusive: bool = False,
-                high_inclusive: bool = False, unit: str = "") -> float:
-    """``value`` as float if it lies in the interval (or [ ]) from ``low`` to ``high``."""
-    number = _as_float(name, value)
-    above = number >= low if low_inclusive else number > low
-    below = number <= high if high_inclusive else number < high
-    if math.isnan(number) or not (above and below):
-        raise ValueError(f"{range_message(name, low, high, low_inclusive, high_inclusive, unit)}; got {value!r}")
-    return number
+def check_choice(name: str, value, registry) -> str:
+    """A text input (``model`` …) that must be a key of ``registry``."""
+    if not isinstance(value, str) or value not in registry:
+        raise InputError(f"{name} must be one of {', '.join(registry)}; got {value!r}", name)
+    return value
 
 
-def check_exclusive(first: str, first_value, second: str, second_value) -> None:
-    """Refuse two options that say the same thing in two ways."""
-    if first_value is not None and second_value is not None:
-        raise ValueError(f"give either {first} or {second}, not both")
+def conflict_message(names) -> str:
+    """``give either velocity or drop_height, not both`` (or one of three)."""
+    names = list(names)
+    listed = " or ".join(names) if len(names) == 2 else ", ".join(names[:-1]) + " or " + names[-1]
+    return f"give either {listed}, not both" if len(names) == 2 else f"give only one of {listed}"
+
+
+class MessageBook:
+    """One message per row as a small integer code (0: none), with one text per code.
+
+    The first message set on a row wins (a row is refused for its first problem)."""
+
+    def __init__(self, rows: int):
+        self.codes = np.zeros(rows, dtype=np.int32)
+        self.texts: list[str] = [""]
+        self.arguments: list[str | None] = [None]
+        self._index: dict[str, int] = {"": 0}
+
+    def code(self, text: str, argument: str | None = None) -> int:
+        code = self._index.get(text)
+        if code is None:
+            code = self._index[text] = len(self.texts)
+            self.texts.append(text)
+            self.arguments.append(argument)
+        return code
+
+    def set(self, mask, text: str, argument: str | None = None) -> None:
+        """Give ``text`` to the rows of boolean ``mask`` that have no message yet."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.any():
+            self.codes[mask & (self.codes == 0)] = self.code(text, argument)
+
+    def set_row(self, row: int, text: str, argument: str | None = None) -> None:
+        if self.codes[row] == 0:
+            self.codes[row] = self.code(text, argument)
+
+    @property
+    def flagged(self) -> np.ndarray:
+        return self.codes != 0
+
+    def text(self, row: int) -> str:
+        return self.texts[self.codes[row]]
+
+    def argument(self, row: int) -> str | None:
+        return self.arguments[self.codes[row]]
+
+
+class WarningBook:
+    """Warnings per row as bits of an integer mask, with one text per bit; rows may
+    carry several.  ``render`` joins a row's texts with "; "."""
+
+    def __init__(self, rows: int):
+        self.masks = np.zeros(rows, dtype=np.int64)
+        self.texts: list[str] = []
+        self._index: dict[str, int] = {}
+
+    def add(self, mask, text: str) -> None:
+        mask = np.asarray(mask, dtype=bool)
+        if not mask.any():
+            return
+        bit = self._index.get(text)
+        if bit is None:
+            if len(self.texts) >= 62:  # more distinct warnings than bits: keep the first 62
+                return
+            bit = self._index[text] = len(self.texts)
+            self.texts.append(text)
+        self.masks[mask] |= np.int64(1) << np.int64(bit)
+
+    def row(self, row: int) -> list[str]:
+        mask = int(self.masks[row])
+        return [text for bit, text in enumerate(self.texts) if mask >> bit & 1]
+
+    def categories(self) -> tuple[np.ndarray, list[str]]:
+        """(codes, categories): each row's joined warning text as a categorical."""
+        unique, codes = np.unique(self.masks, return_inverse=True)
+        categories = []
+        for mask in unique:
+            categories.append("; ".join(t for bit, t in enumerate(self.texts) if int(mask) >> bit & 1))
+        return codes.astype(np.int32), categories
+
+
+def implausible_message(quantity: Quantity, value: float | None = None) -> str:
+    """The warning of an input outside the plausible range for fruit (with its value, for one impact)."""
+    plausible = quantity.plausible
+    unit = f" {quantity.si_unit}" if quantity.si_unit else ""
+    plain = f"; a plain number is read in {quantity.si_unit}" if quantity.si_unit else ""
+    shown = f" = {float(value):.6g}{unit}" if value is not None else ""
+    return (f"{quantity.name}{shown} is outside the plausible range for fruit, "
+            f"[{plausible.low:g}, {plausible.high:g}]{unit}{plain}")
+
+
+__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_value", "conflict_message",
+           "implausible_message", "nan_message", "range_message", "read_value", "unreadable_message"]

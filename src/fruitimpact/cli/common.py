@@ -13,7 +13,9 @@ import math
 import re
 import sys
 
+from ..quantities import INPUTS, option_of
 from ..units import parse_quantity
+from ..validation import conflict_message
 
 PROG = "fruitimpact"
 
@@ -27,18 +29,14 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-# (option, dimension, help) of the impact inputs; option names are a contract.
-IMPACT_OPTIONS = (
-    ("--mass", "mass", "fruit mass M (e.g. 115g) [kg]"),
-    ("--diameter", "length", "fruit diameter d (e.g. 65mm) [m]"),
-    ("--modulus", "modulus", "Young's modulus E of the flesh (e.g. 3MPa) [Pa]"),
-    ("--poisson", "dimensionless", "Poisson's ratio ν, in (-1, 0.5)"),
-    ("--stiffness", "stiffness", "contact stiffness k_c [N/m^1.5]; overrides E, ν, d (eq 9)"),
-    ("--velocity", "velocity", "impact velocity V_i (e.g. 1m/s) [m/s]"),
-    ("--drop-height", "length", "drop height h instead of --velocity (e.g. 30cm) [m]"),
-    ("--restitution", "dimensionless", "restitution coefficient k, in (0, 1]"),
-    ("--alpha", "alpha", "Hunt-Crossley α instead of k, k = 1 - α V_i (eq 6) [s/m]"),
-)
+def _help(quantity) -> str:
+    unit = f" [{quantity.si_unit}]" if quantity.si_unit else ""
+    return f"{quantity.doc}{unit}"
+
+
+#: (option, dimension, help) of the numeric impact inputs, from the table of quantities;
+#: option names are a contract.
+IMPACT_OPTIONS = tuple((q.option, q.dimension, _help(q)) for q in INPUTS.values() if q.numeric and q.option)
 
 
 def _dest(option: str) -> str:
@@ -59,56 +57,63 @@ def _quantities(args, options=IMPACT_OPTIONS) -> dict:
     return values
 
 
+def usage_message(exc: ValueError) -> str:
+    """A library error as the CLI's line: the option named from the error's argument."""
+    argument = getattr(exc, "argument", None)
+    if isinstance(argument, tuple):  # a conflict between inputs given together
+        return conflict_message([option_of(name) for name in argument])
+    if isinstance(argument, str) and argument in INPUTS:
+        return f"argument {option_of(argument)}: {exc}"
+    return str(exc)
+
+
 def _library_call(func, *args, **kwargs):
     """Run a library call, turning its ValueError into the CLI's one-line error."""
     try:
         return func(*args, **kwargs)
     except ValueError as exc:
-        raise UsageError(_with_option(str(exc))) from None
+        raise UsageError(usage_message(exc)) from None
 
 
 def _with_option(message: str) -> str:
-    """Prefix a library message with the CLI option it concerns ("mass ..." → "argument --mass: mass ...")."""
+    """Prefix a batch row's message with the CLI option it concerns ("mass ..." → "argument --mass: mass ...")."""
     if message.startswith("give either"):  # a conflict: name both options as typed
         words = message.split()
         return f"give either --{words[2].replace('_', '-')} or --{words[4].rstrip(',').replace('_', '-')}, not both"
     name = message.split(" ", 1)[0]
-    option = "--" + name.replace("_", "-")
-    known = {o for o, _, _ in IMPACT_OPTIONS} | {"--model", "--calibration", "--method", "--step"}
-    if option in known:
-        return f"argument {option}: {message}"
+    if name in INPUTS:
+        return f"argument {option_of(name)}: {message}"
     return message
 
 
 def _add_impact_options(parser: argparse.ArgumentParser) -> None:
-    from ..models import CALIBRATIONS, DAMPING_LAWS
-    from ..solvers import SOLVERS
+    from ..registries import REGISTRIES
 
     group = parser.add_argument_group("fruit and impact (plain numbers are SI; units accepted)")
-    for option, _, text in IMPACT_OPTIONS:
-        group.add_argument(option, metavar="VALUE", help=text)
-    group.add_argument("--model", default="hunt-crossley", metavar="{" + ",".join(DAMPING_LAWS) + "}",
-                       help="damping law (default hunt-crossley)")
-    group.add_argument("--calibration", default="exact", metavar="{" + ",".join(CALIBRATIONS) + "}",
-                       help="exact: λ gives exactly the requested k (default); paper: the law's formula")
-    group.add_argument("--method", default="accurate", metavar="{" + ",".join(SOLVERS) + "}",
-                       help="accurate (default) or rk4, the paper's fixed-step method")
-    group.add_argument("--step", default="1e-4", metavar="VALUE", help="RK4 time step (default 1e-4 s) [s]")
+    for quantity in INPUTS.values():
+        if not quantity.option:
+            continue
+        if quantity.numeric:
+            group.add_argument(quantity.option, metavar="VALUE", help=_help(quantity))
+        else:
+            choices = "{" + ",".join(REGISTRIES[quantity.choices]) + "}"
+            group.add_argument(quantity.option, metavar=choices, help=f"{quantity.doc} (default {quantity.default})")
+
+
+#: The inputs that describe the fruit and the surface (``Fruit`` and ``Surface`` fields).
+_FRUIT = ("mass", "diameter", "modulus", "poisson", "stiffness")
+_SURFACE = {"surface_modulus": "modulus", "surface_poisson": "poisson", "surface_radius": "radius"}
 
 
 def _simulate_kwargs(args) -> dict:
-    from ..impact import Fruit
+    """``simulate()`` keywords from the given options, as typed (the library reads the units)."""
+    from ..impact import Fruit, Surface
 
-    values = _quantities(args)
-    try:
-        step = parse_quantity(args.step, "time")
-    except ValueError as exc:
-        raise UsageError(f"argument --step: {exc}") from None
-    fruit_fields = {k: values[k] for k in ("mass", "diameter", "modulus", "poisson", "stiffness") if k in values}
-    fruit = _library_call(Fruit, **fruit_fields)
-    return dict(fruit=fruit, velocity=values.get("velocity"), drop_height=values.get("drop_height"),
-                restitution=values.get("restitution"), alpha=values.get("alpha"), model=args.model,
-                calibration=args.calibration, method=args.method, step=step)
+    given = {name: getattr(args, name) for name in INPUTS if getattr(args, name, None) is not None}
+    fruit = _library_call(Fruit, **{name: given.pop(name) for name in _FRUIT if name in given})
+    surface_fields = {field: given.pop(name) for name, field in _SURFACE.items() if name in given}
+    surface = _library_call(Surface, **surface_fields) if surface_fields else None
+    return dict(fruit=fruit, surface=surface, **given)
 
 
 def _json_default(value):
@@ -150,9 +155,8 @@ def _float_list(option: str, text: str, low: float, high: float, high_inclusive:
 
 
 #: Numeric inputs of sweep and population: (option, column, dimension); text inputs: (option, column).
-RUN_NUMERIC = tuple((option, _dest(option), dimension) for option, dimension, _ in IMPACT_OPTIONS) \
-    + (("--step", "step", "time"),)
-RUN_TEXT = (("--model", "model"), ("--calibration", "calibration"), ("--method", "method"))
+RUN_NUMERIC = tuple((option, _dest(option), dimension) for option, dimension, _ in IMPACT_OPTIONS)
+RUN_TEXT = tuple((q.option, q.name) for q in INPUTS.values() if not q.numeric)
 #: Inputs whose range depends on other inputs: not checked alone when constant.
 _DEPENDENT_INPUTS = ("alpha", "step")
 
@@ -177,8 +181,7 @@ def _positive_count(option: str, text: str, minimum: int = 1) -> int:
 
 
 
-_SI_OF = {"mass": "kg", "diameter": "m", "modulus": "Pa", "poisson": "", "stiffness": "N/m^1.5", "velocity": "m/s",
-          "drop_height": "m", "restitution": "", "alpha": "s/m", "step": "s"}
+_SI_OF = {name: quantity.si_unit for name, quantity in INPUTS.items() if quantity.numeric}
 
 
 

@@ -5,17 +5,27 @@ from __future__ import annotations
 
 import math
 
-from .common import UsageError, _float_list, dump_json
+from .common import UsageError, _float_list, _library_call, dump_json
+
+
+def _checked(check, *args):
+    try:
+        return check(*args)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def cmd_paper(args) -> int:
-    from ..paper import paper_report, format_paper_report
+    from ..outputs import check_output_folder
+    from ..paper import format_paper_report, paper_report
 
+    if args.figures:
+        _checked(check_output_folder, args.figures, "--figures")
     report = paper_report()
     if args.figures:
         from ..paper import write_paper_figures
 
-        report["figures"] = write_paper_figures(args.figures)
+        report["figures"] = _library_call(write_paper_figures, args.figures)
     if args.json:
         print(dump_json(report))
     else:
@@ -25,7 +35,8 @@ def cmd_paper(args) -> int:
 
 
 def cmd_models(args) -> int:
-    from ..comparison import format_restitution_table, restitution_figure, restitution_table
+    from ..comparison import format_restitution_table, restitution_table
+    from ..plotting import restitution_figure
     from ..models import DAMPING_LAWS
 
     for name in args.model or ():
@@ -33,13 +44,19 @@ def cmd_models(args) -> int:
             raise UsageError(f"argument --model: model must be one of {', '.join(DAMPING_LAWS)}; got {name!r}")
     targets = _float_list("--targets", args.targets, 0.0, 1.0, True)
     velocities = _float_list("--velocities", args.velocities, 0.0, math.inf, False)
+    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, atomic_write, check_output
+
+    if args.csv:
+        _checked(check_output, args.csv, "--csv", CSV_FORMAT)
+    if args.plot:
+        _checked(check_output, args.plot, "--plot", FIGURE_FORMATS)
     table = restitution_table(args.model, targets, velocities)
     if args.csv:
-        table.to_csv(args.csv, index=False)
+        _library_call(atomic_write, args.csv, lambda tmp: table.to_csv(tmp, index=False), "--csv")
     if args.plot:
         from ..plotting import save_figure
 
-        save_figure(restitution_figure(table), args.plot)
+        _library_call(save_figure, restitution_figure(table), args.plot, "--plot")
     if args.json:
         print(dump_json(table.to_dict(orient="records")))
     else:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import math
+import sys
 
-from ..quantities import CHARACTERISTICS
-from .common import (UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json)
+from ..quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS
+from .common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
 
 
 def _law_line(law) -> str:
@@ -24,7 +25,8 @@ def format_result_table(result) -> str:
         f"E = {fruit.modulus / 1e6:.4g} MPa, ν = {fruit.poisson:.4g}",
         f"impact     V_i = {inputs.velocity:.4g} m/s"
         + (f" (drop {inputs.drop_height * 100:.4g} cm)" if inputs.drop_height is not None else "")
-        + (f", target k = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else ""),
+        + (f", target e = {inputs.target_restitution:.4g}" if inputs.target_restitution is not None else "")
+        + (f", α = {inputs.alpha:.4g} s/m" if inputs.alpha is not None else ""),
         f"law        {inputs.model}, calibration {inputs.calibration}, method {inputs.method}"
         + (f" (step {inputs.step:g} s)" if inputs.method == "rk4" else ""),
         _law_line(result.law),
@@ -32,7 +34,7 @@ def format_result_table(result) -> str:
         f"{'characteristic':<28}{'value':>14}  unit",
         f"{'-' * 28}{'-' * 14}  {'-' * 6}",
     ]
-    for quantity in list(CHARACTERISTICS.values())[:12]:
+    for quantity in (CHARACTERISTICS[name] for name in CHARACTERISTIC_NAMES):
         value = getattr(c, quantity.name) * quantity.scale
         lines.append(f"{quantity.label:<28}{value:>14.6g}  {quantity.unit}")
     if not math.isnan(c.max_deflection_closed_form):
@@ -42,7 +44,7 @@ def format_result_table(result) -> str:
                   f"  e     = {c.restitution_closed_form:.9g} "
                   f"(relative difference {c.restitution / c.restitution_closed_form - 1:+.1e})"]
     if not result.success:
-        lines += ["", f"FAILED: {result.message}"]
+        lines += ["", f"{result.status.upper()}: {result.message}"]
     return "\n".join(lines)
 
 
@@ -65,24 +67,41 @@ def _overlays(args) -> list[dict]:
     return overlays
 
 
+def _check_outputs(args) -> None:
+    """Every output path and format, before the impact is computed."""
+    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
+
+    for option, path, formats in (("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS)):
+        if path is not None:
+            try:
+                check_output(path, option, formats)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+
+
 def cmd_simulate(args) -> int:
     from ..impact import simulate
 
     kwargs = _simulate_kwargs(args)
+    overlays = _overlays(args)
+    _check_outputs(args)
     result = _library_call(simulate, **kwargs)
-    if args.csv:
-        result.curves.to_csv(args.csv)
-    if args.plot:
+    for warning in result.warnings:
+        print(f"{PROG} simulate: warning: {warning}", file=sys.stderr)
+    if args.csv and result.status != "failed":
+        _library_call(result.curves.to_csv, args.csv, argument="--csv")
+    if args.plot and result.status != "failed":
         from ..plotting import impact_figure, save_figure
 
-        results = [result] + [_library_call(simulate, **{**kwargs, **overlay}) for overlay in _overlays(args)]
-        save_figure(impact_figure(results, title="fruitimpact: impact of the fruit on the surface"), args.plot)
+        results = [result] + [_library_call(simulate, **{**kwargs, **overlay}) for overlay in overlays]
+        _library_call(save_figure, impact_figure(results, title="fruitimpact: impact of the fruit on the surface"),
+                      args.plot, "--plot")
     if args.json:
         print(dump_json(result.to_dict()))
     else:
         print(format_result_table(result))
         for what, path in (("curves", args.csv), ("figure", args.plot)):
-            if path:
+            if path and result.status != "failed":
                 print(f"{what} written to {path}")
     return 0 if result.success else 1
 

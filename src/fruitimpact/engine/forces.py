@@ -13,14 +13,7 @@ import math
 
 import numba as nb
 
-#: F = K δ^n (1 + c δ̇); params (K [N/m^n], n [-], c [s/m]).  Hunt & Crossley 1975.
-POWER_LAW = 0
-#: F = k δ + b δ̇; params (k [N/m], b [N·s/m]).  Linear Kelvin–Voigt spring–dashpot.
-KELVIN_VOIGT = 1
-#: F = K (δ^1.5 + B δ^0.5 δ̇); params (K [N/m^1.5], B [s]).  Kuwabara & Kono 1987, Brilliantov et al. 1996.
-KUWABARA_KONO = 2
-#: F = K δ^1.5 + η δ^0.25 δ̇; params (K [N/m^1.5], η [N·s/m^1.25]).  Tsuji, Tanaka & Ishida 1992.
-TSUJI = 3
+from .codes import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, TSUJI  # noqa: F401  (the family codes)
 
 _JIT = dict(cache=True, error_model="numpy")
 

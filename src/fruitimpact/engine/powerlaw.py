@@ -40,22 +40,9 @@ from .quadrature import gauss_jacobi
 #: analytic; 16 nodes already reach 1e-13 relative for e ≥ 0.05, 20 leave a margin (tests).
 QUADRATURE_NODES = 20
 
-#: Column order of the characteristics array returned by the kernels.
-CHARACTERISTIC_COLUMNS = (
-    "peak_force",
-    "time_to_peak",
-    "contact_duration",
-    "max_deflection",
-    "time_to_max_deflection",
-    "exit_velocity",
-    "restitution",
-    "absorbed_energy",
-    "firmness_c",
-    "firmness_c_star",
-    "max_pressure",
-    "contact_radius",
-)
-N_CHARACTERISTICS = len(CHARACTERISTIC_COLUMNS)
+from .codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_DURATION, CONTACT_RADIUS,  # noqa: F401
+                    EXIT_VELOCITY, FIRMNESS_C, FIRMNESS_C_STAR, MAX_DEFLECTION, MAX_PRESSURE, N_CHARACTERISTICS,
+                    PEAK_FORCE, RESTITUTION, TIME_TO_MAX_DEFLECTION, TIME_TO_PEAK)
 
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 
@@ -67,18 +54,18 @@ def fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection
     from what every solver measures: the peak force [N] and its time [s], the
     contact duration [s], δ_max [m] and its time [s], the rebound speed [m/s],
     and the largest F/δ [N/m] over the contact (for the Hertz pressure)."""
-    out[0] = peak_force
-    out[1] = time_to_peak
-    out[2] = duration
-    out[3] = max_deflection
-    out[4] = time_to_max
-    out[5] = exit_speed
-    out[6] = exit_speed / velocity
-    out[7] = 0.5 * mass * (velocity - exit_speed) * (velocity + exit_speed)
-    out[8] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
-    out[9] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
-    out[10] = 3.0 * max_force_ratio / (2.0 * math.pi * radius)  # p0 = 3F/(2π a²), a² = R δ
-    out[11] = math.sqrt(radius * max_deflection)
+    out[PEAK_FORCE] = peak_force
+    out[TIME_TO_PEAK] = time_to_peak
+    out[CONTACT_DURATION] = duration
+    out[MAX_DEFLECTION] = max_deflection
+    out[TIME_TO_MAX_DEFLECTION] = time_to_max
+    out[EXIT_VELOCITY] = exit_speed
+    out[RESTITUTION] = exit_speed / velocity
+    out[ABSORBED_ENERGY] = 0.5 * mass * (velocity - exit_speed) * (velocity + exit_speed)
+    out[FIRMNESS_C] = peak_force / time_to_peak if time_to_peak > 0.0 else math.nan
+    out[FIRMNESS_C_STAR] = peak_force / (time_to_peak * time_to_peak) if time_to_peak > 0.0 else math.nan
+    out[MAX_PRESSURE] = 3.0 * max_force_ratio / (2.0 * math.pi * radius)  # p0 = 3F/(2π a²), a² = R δ
+    out[CONTACT_RADIUS] = math.sqrt(radius * max_deflection)
 
 
 @nb.njit(**_JIT)
@@ -415,42 +402,136 @@ def restitution_of_x(x):
     return -zeta0 * e1_func(x * zeta0)
 
 
+#: Below this e the root is polished in u (near the pole x = 1/e), above it in x.
+_SMALL_E = 0.25
+
+
 @nb.njit(**_JIT)
-def x_of_restitution(e):
-    """x = c·v0 ≥ 0 for which the law F = K δ^n (1 + c δ̇) gives restitution e
-    in (0, 1].  f(x) = e² r(-x e) - r(x) rises from (e² - 1)/2 at x = 0 to +∞
-    at x = 1/e; safeguarded Newton inside that bracket."""
-    if e >= 1.0:
-        return 0.0
+def _newton_x(e, x):
+    """Root of f(x) = e² r(-x e) - r(x) in (0, 1/e) by safeguarded Newton from ``x``.
+
+    f rises from (e² - 1)/2 at x = 0 to +∞ at x = 1/e (the trivial root x = 0 of the
+    exact relation is divided out by r), so it is well conditioned for e near 1."""
     lo = 0.0
     hi = 1.0 / e
-    x = min(1.5 * (1.0 - e) / e, 0.5 * hi)  # Hunt–Crossley first-order guess, kept inside
+    if not (lo < x < hi):
+        x = min(1.5 * (1.0 - e) / e, 0.5 * hi)  # Hunt–Crossley first-order guess, kept inside
     for _ in range(200):
         f = e * e * r_func(-x * e) - r_func(x)
+        if f == 0.0:
+            return x
         if f > 0.0:
             hi = x
         else:
             lo = x
         df = -e * e * e * r_prime(-x * e) - r_prime(x)
         x_new = x - f / df if df > 0.0 else 0.5 * (lo + hi)
-        if not (lo < x_new < hi):
+        if not (lo <= x_new <= hi):
             x_new = 0.5 * (lo + hi)
-        if abs(x_new - x) <= 2e-16 * x_new or hi - lo <= 2e-16 * hi:
+        if abs(x_new - x) <= 1e-8 * x_new:
+            # quadratic convergence: this step left an error ~1e-16; one more reaches rounding
+            # (asking for 2e-16 instead makes Newton dither by an ulp and fall back to bisection)
+            f = e * e * r_func(-x_new * e) - r_func(x_new)
+            df = -e * e * e * r_prime(-x_new * e) - r_prime(x_new)
+            final = x_new - f / df if df > 0.0 else x_new
+            return final if lo <= final <= hi else x_new
+        if hi - lo <= 2e-16 * hi:
             return x_new
         x = x_new
     return x
 
 
-@nb.njit(parallel=True, **_JIT)
-def _vector_x_of_restitution(e, out):
-    for i in nb.prange(e.shape[0]):
-        out[i] = x_of_restitution(e[i])
+@nb.njit(**_JIT)
+def _newton_u(e, u):
+    """Root of the exact relation for small e, in u = -ln(1 - e x): x = -expm1(-u)/e stays
+    below the pole 1/e for every u, and H(u) = ln(1 + x) + u - (1 + e) x is smooth there
+    (its trivial root u = 0 is far when e is small).  Newton from ``u``; returns x."""
+    for _ in range(100):
+        decay = math.exp(-u)
+        x = -math.expm1(-u) / e
+        h = math.log1p(x) + u - (1.0 + e) * x
+        dh = 1.0 + (1.0 / (1.0 + x) - (1.0 + e)) * decay / e
+        step = h / dh
+        u_new = u - step
+        if u_new <= 0.0:
+            u_new = 0.5 * u
+        if abs(u_new - u) <= 1e-8 * u_new:  # quadratic: one more step reaches rounding
+            x = -math.expm1(-u_new) / e
+            h = math.log1p(x) + u_new - (1.0 + e) * x
+            dh = 1.0 + (1.0 / (1.0 + x) - (1.0 + e)) * math.exp(-u_new) / e
+            return -math.expm1(-(u_new - h / dh)) / e
+        u = u_new
+    return -math.expm1(-u) / e
 
 
 @nb.njit(**_JIT)
-def _vector_x_of_restitution_serial(e, out):
+def _x_from_guess(e, u):
+    """x for restitution e from a guess ``u`` of u = -ln(1 - e x) (in u near the pole
+    x = 1/e, where small e puts the root; in x otherwise)."""
+    if e < _SMALL_E:
+        return _newton_u(e, u)
+    return _newton_x(e, -math.expm1(-u) / e)
+
+
+@nb.njit(**_JIT)
+def x_of_restitution(e):
+    """x = c·v0 ≥ 0 for which the law F = K δ^n (1 + c δ̇) gives restitution e
+    in (0, 1]: the root of (1 + x) = (1 - e x) exp((1 + e) x) in (0, 1/e), by
+    safeguarded Newton (``_newton_u`` for small e, ``_newton_x`` otherwise) from
+    a first-order guess.  ``exact_x`` does the same from a tabulated guess."""
+    if e >= 1.0:
+        return 0.0
+    if not (e > 0.0):
+        return math.nan
+    if e < _SMALL_E:
+        x = 1.0 / e  # the root tends to the pole as e → 0
+        return _x_from_guess(e, (1.0 + e) * x - math.log1p(x))
+    x = 1.5 * (1.0 - e) / e  # Hunt–Crossley first order, kept below the pole
+    return _x_from_guess(e, -math.log1p(-min(e * x, 0.5)))
+
+
+#: Starting guesses of ``exact_x`` on a uniform grid of e: g(e) = e u/(1 - e) with
+#: u = -ln(1 - e x), smooth and between 1 and 1.5 on (0, 1) (x ≈ 1.5 (1 - e) as e → 1,
+#: x ≈ 1/e as e → 0), interpolated linearly (error ~1e-7, so Newton needs 2–3 steps).
+_GUESS_NODES = 2049
+_GUESS: list = []
+
+
+def _guess_table() -> np.ndarray:
+    if not _GUESS:
+        e = np.linspace(0.0, 1.0, _GUESS_NODES)
+        g = np.empty_like(e)
+        g[0], g[-1] = 1.0, 1.5
+        for i in range(1, _GUESS_NODES - 1):
+            x = x_of_restitution(e[i])
+            u = (1.0 + e[i]) * x - math.log1p(x)  # = -ln(1 - e x) at the root, without cancellation
+            g[i] = u * e[i] / (1.0 - e[i])
+        _GUESS.append(g)
+    return _GUESS[0]
+
+
+@nb.njit(**_JIT)
+def _x_from_table(e, table):
+    if e >= 1.0:
+        return 0.0
+    if not (e > 0.0):
+        return math.nan
+    position = e * (table.shape[0] - 1)
+    i = min(int(position), table.shape[0] - 2)
+    g = table[i] + (position - i) * (table[i + 1] - table[i])
+    return _x_from_guess(e, g * (1.0 - e) / e)
+
+
+@nb.njit(parallel=True, **_JIT)
+def _vector_x_of_restitution(e, table, out):
+    for i in nb.prange(e.shape[0]):
+        out[i] = _x_from_table(e[i], table)
+
+
+@nb.njit(**_JIT)
+def _vector_x_of_restitution_serial(e, table, out):
     for i in range(e.shape[0]):
-        out[i] = x_of_restitution(e[i])
+        out[i] = _x_from_table(e[i], table)
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -474,7 +555,8 @@ def exact_x(restitution):
     """Vectorised ``x_of_restitution``: x = c·v0 from e ∈ (0, 1]."""
     e = np.ascontiguousarray(np.atleast_1d(np.asarray(restitution, dtype=float)).ravel())
     out = np.empty_like(e)
-    (_vector_x_of_restitution if e.shape[0] > PARALLEL_MIN_ROWS else _vector_x_of_restitution_serial)(e, out)
+    kernel = _vector_x_of_restitution if e.shape[0] > PARALLEL_MIN_ROWS else _vector_x_of_restitution_serial
+    kernel(e, _guess_table(), out)
     return out.reshape(np.shape(restitution))
 
 
@@ -527,8 +609,9 @@ def _dimensionless(x, n, rules):
     stiffness = (n + 1.0) / 2.0
     out = np.empty((len(x), N_CHARACTERISTICS))
     _characteristics_kernel_serial(ones, ones * stiffness, n, x, ones, ones, *rules, out)
-    return np.column_stack([out[:, 6], out[:, 3], out[:, 1], out[:, 2], out[:, 4], out[:, 0] / stiffness,
-                            out[:, 10] / stiffness])
+    return np.column_stack([out[:, RESTITUTION], out[:, MAX_DEFLECTION], out[:, TIME_TO_PEAK], out[:, CONTACT_DURATION],
+                            out[:, TIME_TO_MAX_DEFLECTION], out[:, PEAK_FORCE] / stiffness,
+                            out[:, MAX_PRESSURE] / stiffness])
 
 
 def powerlaw_table(exponent: float = 1.5) -> tuple[np.ndarray, float]:

@@ -155,4 +155,13 @@ def rk4_batch(family, params, clamp, mass, velocity, radius, step, max_steps, ou
                    max_steps, False, dummy, dummy, dummy, dummy, out[i])
 
 
-__all__ = ["rk4_impact", "rk4_batch", "CHARACTERISTIC_COLUMNS", "N_CHARACTERISTICS"]
+@nb.njit(**_JIT)
+def rk4_batch_serial(family, params, clamp, mass, velocity, radius, step, max_steps, out):
+    """``rk4_batch`` on one thread: for a few rows, where starting threads costs more than the work."""
+    dummy = np.empty(1)
+    for i in range(mass.shape[0]):
+        rk4_impact(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], step[i],
+                   max_steps, False, dummy, dummy, dummy, dummy, out[i])
+
+
+__all__ = ["rk4_impact", "rk4_batch", "rk4_batch_serial", "CHARACTERISTIC_COLUMNS", "N_CHARACTERISTICS"]

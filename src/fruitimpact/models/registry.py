@@ -1,13 +1,8 @@
-"""Registry of contact damping laws and of calibrations.
+"""Registry of damping laws and of calibrations.
 
-A *damping law* says which force law the contact follows and how its damping
-follows from a restitution coefficient e.  Most published laws belong to the
-power-law family used by the paper, F = K δ^(3/2) (1 + c δ̇) (eqs 11, 14, 23;
-λ = c·K is the paper's λ1 or β), and differ only in the closed form
-χ(e) = c·v0 their authors derived.  Others are different force families:
-the linear Kelvin–Voigt spring–dashpot, the viscoelastic-sphere law of
-Kuwabara & Kono / Brilliantov, and the Tsuji law used by DEM codes.
-
+A *damping law* says which force family the contact follows
+(``models.families``) and how its damping follows from a restitution
+coefficient e: the published formula is a function of ``models.laws``.
 A *calibration* says which e → damping rule is applied: the law's own
 published formula (``paper``), or the exact inverse of the restitution the
 law really produces (``exact``), which makes the simulated restitution equal
@@ -16,44 +11,20 @@ the requested one.
 Formulas were checked against the sources and public implementations listed
 in docs/models.md; the achieved-restitution tables there are produced by
 ``fruitimpact models`` and verified by an independent integration in
-tests/test_models.py.  Add a law by adding a ``DampingLaw`` to
-``DAMPING_LAWS``; nothing else needs to change.
+tests/test_models.py.  Add a law by writing its function in ``models.laws``
+and registering a ``DampingLaw`` here; nothing else needs to change.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import forces
-from .engine.powerlaw import exact_x
-
-#: First-order coefficient of the Kuwabara–Kono restitution, e = 1 - C1 b + ...,
-#: b = B (K/m)^(2/5) v0^(1/5):  C1 = Γ(3/5) √π / (2^(1/5) 5^(2/5) Γ(21/10)) = 1.153449
-#: (Schwager & Pöschel, Phys. Rev. E 78 (2008) 051304; Ramírez et al., Phys. Rev. E 60 (1999) 4465).
-KUWABARA_KONO_C1 = math.gamma(0.6) * math.sqrt(math.pi) / (2 ** 0.2 * 5 ** 0.4 * math.gamma(2.1))
-
-#: Undamped Hertz contact duration T = HERTZ_DURATION_FACTOR · δ_H / v0 = (4/5) B(1/2, 2/5) δ_H/v0.
-HERTZ_DURATION_FACTOR = 0.8 * math.gamma(0.5) * math.gamma(0.4) / math.gamma(0.9)
-
-
-def _log_decrement_ratio(e):
-    """ζ = -ln e / sqrt(π² + ln² e): damping ratio of a linear oscillator whose
-    half-period decay is e (exact for the unclamped linear law)."""
-    log_e = np.log(e)
-    return -log_e / np.sqrt(np.pi ** 2 + log_e ** 2)
-
-
-def hertz_equivalent_linear_stiffness(mass, stiffness, velocity):
-    """k [N/m] of the linear spring whose undamped contact duration π sqrt(m/k)
-    equals the Hertz one at this impact, 2.943 δ_H/v0 (the usual way DEM codes
-    match a linear law to a Hertz contact)."""
-    delta_h = (1.25 * mass * velocity ** 2 / stiffness) ** 0.4
-    duration = HERTZ_DURATION_FACTOR * delta_h / velocity
-    return mass * (math.pi / duration) ** 2
+from ..engine import codes as forces
+from . import laws
+from .families import FAMILIES, ForceFamily
 
 
 @dataclass(frozen=True)
@@ -71,19 +42,16 @@ class DampingLaw:
     validity : str
         The range of e for which the source derived or recommends it.
     family : int
-        Force family (``engine.forces``): POWER_LAW, KELVIN_VOIGT, KUWABARA_KONO or TSUJI.
+        Engine code of the force family (``force_family`` is its record).
     clamp : bool
         Whether the fruit separates as soon as the force would become tensile.
-    chi : callable or None
-        Power-law family only: χ(e) = c·v0 [-] as published; None means λ = 0.
     published : callable or None
-        Other families: (e, m, K, v0) → damping factor as published (see ``ContactLaw``).
-    group : callable or None
-        Other families: (damping factor, m, K, v0) → the dimensionless damping group on
-        which alone the restitution depends; with ``from_group`` its inverse.
-    from_group : callable or None
+        The law's function of ``models.laws``: e → the family's dimensionless damping
+        group as published; None means undamped (λ = 0).
     note : str
         What else a user should know (aliases, unconfirmed transcriptions).
+    exact_by_construction : bool
+        The published calibration already gives the requested e exactly.
     """
 
     name: str
@@ -92,77 +60,36 @@ class DampingLaw:
     validity: str
     family: int = forces.POWER_LAW
     clamp: bool = True
-    chi: Callable | None = None
     published: Callable | None = None
-    group: Callable | None = None
-    from_group: Callable | None = None
     note: str = ""
-    #: the published calibration already gives the requested e exactly
     exact_by_construction: bool = False
 
     @property
+    def force_family(self) -> ForceFamily:
+        return FAMILIES[self.family]
+
+    @property
     def undamped(self) -> bool:
-        return self.family == forces.POWER_LAW and self.chi is None and not self.exact_by_construction
+        return self.published is None
 
     def linear_stiffness(self, mass, stiffness, velocity):
         """The stiffness the law's force uses: K for the Hertz-type laws, the
         Hertz-equivalent linear k for Kelvin–Voigt."""
-        if self.family == forces.KELVIN_VOIGT:
-            return hertz_equivalent_linear_stiffness(mass, stiffness, velocity)
-        return stiffness
+        return self.force_family.elastic_stiffness(mass, stiffness, velocity)
+
+    def group(self, factor, mass, stiffness, velocity):
+        """The dimensionless damping group of a damping factor (``ForceFamily.to_group``)."""
+        return self.force_family.to_group(factor, mass, stiffness, velocity)
+
+    def from_group(self, group, mass, stiffness, velocity):
+        """The damping factor of a dimensionless damping group (``ForceFamily.from_group``)."""
+        return self.force_family.from_group(group, mass, stiffness, velocity)
 
     def published_damping_factor(self, restitution, mass, stiffness, velocity):
-        """Damping factor (see ``ContactLaw``) by the law's own formula."""
-        if self.family == forces.POWER_LAW:
-            if self.exact_by_construction:
-                return exact_x(restitution) / velocity
-            return 0.0 if self.chi is None else self.chi(restitution) / velocity
-        return self.published(restitution, mass, stiffness, velocity)
-
-
-def _kv_published(e, m, k_hertz, v):
-    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
-    zeta = _log_decrement_ratio(e)
-    return 2.0 * zeta * np.sqrt(k * m) / k  # b/k [s]
-
-
-def _kv_group(factor, m, k_hertz, v):
-    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
-    return factor * k / (2.0 * np.sqrt(k * m))  # ζ
-
-
-def _kv_from_group(zeta, m, k_hertz, v):
-    k = hertz_equivalent_linear_stiffness(m, k_hertz, v)
-    return 2.0 * zeta * np.sqrt(k * m) / k
-
-
-def _kk_published(e, m, k, v):
-    return (1.0 - e) / (KUWABARA_KONO_C1 * (k / m) ** 0.4 * v ** 0.2)  # B [s]
-
-
-def _kk_group(factor, m, k, v):
-    return factor * (k / m) ** 0.4 * v ** 0.2  # b
-
-
-def _kk_from_group(b, m, k, v):
-    return b / ((k / m) ** 0.4 * v ** 0.2)
-
-
-def _tsuji_alpha(e):
-    log_e = np.log(e)
-    return -np.sqrt(5.0) * log_e / np.sqrt(log_e ** 2 + np.pi ** 2)
-
-
-def _tsuji_published(e, m, k, v):
-    return _tsuji_alpha(e) * np.sqrt(m * k) / k  # η/K
-
-
-def _tsuji_group(factor, m, k, v):
-    return factor * k / np.sqrt(m * k)  # α
-
-
-def _tsuji_from_group(alpha, m, k, v):
-    return alpha * np.sqrt(m * k) / k
+        """Damping factor (see ``impact.ContactLaw``) by the law's own formula."""
+        if self.published is None:
+            return np.zeros_like(np.asarray(restitution, dtype=float))
+        return self.from_group(self.published(restitution), mass, stiffness, velocity)
 
 
 _MACHADO = ("transcription as in Machado et al., Mech. Mach. Theory 53 (2012) 99-121, and in the public DyS code "
@@ -187,19 +114,19 @@ register(DampingLaw(
     source=("K. H. Hunt, F. R. E. Crossley, Coefficient of restitution interpreted as damping in vibroimpact, "
             "J. Appl. Mech. 42 (1975) 440-445; apple paper eqs 5, 6, 11: λ = (3/2) α k_c with e = 1 - α v0 "
             "(as in Simbody's HuntCrossleyForce and Marhefka & Orin 1999)."),
-    chi=lambda e: 1.5 * (1.0 - e),
+    published=laws.hunt_crossley,
     validity="first order in (1 - e): e close to 1; gives e too high below 0.9"))
 register(DampingLaw(
     name="herbert-mcwhannell", title="Herbert & McWhannell 1977",
     source=("R. G. Herbert, D. C. McWhannell, Shape and frequency composition of pulses from an impact pair, "
             "J. Eng. Ind. 99 (1977) 513-518; χ = 6(1-e)/((2e-1)² + 3); " + _MACHADO + "."),
-    chi=lambda e: 6.0 * (1.0 - e) / ((2.0 * e - 1.0) ** 2 + 3.0),
+    published=laws.herbert_mcwhannell,
     validity="tends to Hunt-Crossley as e → 1; χ stays finite at e = 0, so achieved e never falls below 0.49"))
 register(DampingLaw(
     name="lee-wang", title="Lee & Wang 1983",
     source=("T. W. Lee, A. C. Wang, On the dynamics of intermittent-motion mechanisms, part 1, J. Mech. Transm. "
             "Autom. Des. 105 (1983) 534-540; χ = 3(1-e)/4; " + _MACHADO + "."),
-    chi=lambda e: 0.75 * (1.0 - e),
+    published=laws.lee_wang,
     validity="half the Hunt-Crossley damping even as e → 1 (achieved 1-e ≈ (1-target)/2): inconsistent with this "
              "force law; kept for comparison only"))
 register(DampingLaw(
@@ -207,7 +134,7 @@ register(DampingLaw(
     source=("H. M. Lankarani, P. E. Nikravesh, A contact force model with hysteresis damping for impact analysis "
             "of multibody systems, J. Mech. Des. 112 (1990) 369-376; apple paper eqs 21, 23 (attributed there to "
             "Chen & De Baerdemaeker 1995): λ = β = (3/4) k_c (1 - e²)/v0."),
-    chi=lambda e: 0.75 * (1.0 - e * e),
+    published=laws.lankarani_nikravesh,
     validity="first order in (1 - e), from the energy lost along the undamped path: e close to 1",
     note="The paper calls it 'Chen'; it is the Lankarani–Nikravesh form. Alias: lankarani-nikravesh."),
     "lankarani-nikravesh")
@@ -216,40 +143,41 @@ register(DampingLaw(
     source=("Y. Gonthier, J. McPhee, C. Lange, J.-C. Piedbœuf, A regularized contact model with asymmetric damping "
             "and dwell-time dependent friction, Multibody Syst. Dyn. 11 (2004) 209-233; χ = (1 - e²)/e "
             "(confirmed in two public implementations)."),
-    chi=lambda e: (1.0 - e * e) / e,
+    published=laws.gonthier,
     validity="all e in (0, 1]; over-damps slightly near e = 1 (target 0.9 gives 0.876)"))
 register(DampingLaw(
     name="zhiying-qishao", title="Zhiying & Qishao 2006",
     source=("Q. Zhiying, L. Qishao, Analysis of impact process based on restitution coefficient, J. Dyn. Control "
             "4 (2006) 294-298; χ = 3(1 - e²) exp(2(1 - e))/4; " + _MACHADO + "."),
-    chi=lambda e: 0.75 * (1.0 - e * e) * np.exp(2.0 * (1.0 - e)),
+    published=laws.zhiying_qishao,
     validity="good for e ≈ 0.4-0.9; χ finite at e = 0, so achieved e never falls below 0.18"))
 register(DampingLaw(
     name="flores", title="Flores, Machado, Silva & Martins 2011",
     source=("P. Flores, M. Machado, M. T. Silva, J. M. Martins, On the continuous contact force models for soft "
             "materials in multibody dynamics, Multibody Syst. Dyn. 25 (2011) 357-375; χ = 8(1 - e)/(5e) "
             "(confirmed in the OpenSees documentation and three public implementations)."),
-    chi=lambda e: 1.6 * (1.0 - e) / e,
+    published=laws.flores,
     validity="derived for soft materials over the whole range of e; over-damps slightly (target 0.5 gives 0.470)"))
 register(DampingLaw(
     name="hu-guo", title="Hu & Guo 2015",
     source=("S. Hu, X. Guo, A dissipative contact force model for impact analysis in multibody dynamics, "
             "Multibody Syst. Dyn. 35 (2015) 131-151; χ = 3(1 - e)/(2e)."),
-    chi=lambda e: 1.5 * (1.0 - e) / e,
+    published=laws.hu_guo,
     validity="all e in (0, 1]",
     note="UNCONFIRMED transcription: the only public implementation found uses 3(1 - e)/(4e)."))
 register(DampingLaw(
     name="gharib-hurmuzlu", title="Gharib & Hurmuzlu 2012",
     source=("M. Gharib, Y. Hurmuzlu, A new contact force model for low coefficient of restitution impact, "
             "J. Appl. Mech. 79 (2012) 064506; χ = (1 - e)/e."),
-    chi=lambda e: (1.0 - e) / e,
+    published=laws.gharib_hurmuzlu,
     validity="meant for low e (matches the exact e → 1/χ limit); under-damps near e = 1",
     note="UNCONFIRMED transcription: no public source of the formula could be found."))
 register(DampingLaw(
     name="exact", title="Exact inverse of the Hunt-Crossley first integral",
     source=("this package: χ solves (1 + χ) = (1 - e χ) exp((1 + e) χ), the exact restitution of "
             "F = K δ^n (1 + c δ̇) (first integral of Hunt & Crossley 1975; docs/physics.md)."),
-    validity="all e in (0, 1]: the simulated restitution equals e", exact_by_construction=True))
+    validity="all e in (0, 1]: the simulated restitution equals e", published=laws.exact_power_law,
+    exact_by_construction=True))
 for _clamp in (False, True):
     _suffix = "-clamped" if _clamp else ""
     register(DampingLaw(
@@ -262,8 +190,8 @@ for _clamp in (False, True):
         validity=("exact for every e when unclamped (but the force is b·v0 at first touch and tensile before "
                   "separation)" if not _clamp else
                   "the published ζ(e) assumes no clamp: clamped, the achieved e is higher (target 0.5 gives 0.55)"),
-        family=forces.KELVIN_VOIGT, clamp=_clamp, published=_kv_published, group=_kv_group,
-        from_group=_kv_from_group, exact_by_construction=not _clamp))
+        family=forces.KELVIN_VOIGT, clamp=_clamp, published=laws.kelvin_voigt_damping_ratio,
+        exact_by_construction=not _clamp))
     register(DampingLaw(
         name="tsuji" + _suffix,
         title="Tsuji, Tanaka & Ishida 1992" + (" (force clamped at 0)" if _clamp else ""),
@@ -273,8 +201,7 @@ for _clamp in (False, True):
         validity=("exact for every e and velocity when unclamped (δ^(5/4) makes it a linear oscillator)"
                   if not _clamp else "clamped at F ≥ 0 the achieved e is higher: target 0.2 gives 0.325, 0.5 gives "
                                      "0.550, for any mass, stiffness and velocity"),
-        family=forces.TSUJI, clamp=_clamp, published=_tsuji_published, group=_tsuji_group,
-        from_group=_tsuji_from_group, exact_by_construction=not _clamp))
+        family=forces.TSUJI, clamp=_clamp, published=laws.tsuji_alpha, exact_by_construction=not _clamp))
     register(DampingLaw(
         name="kuwabara-kono" + ("" if _clamp else "-unclamped"),
         title="Kuwabara & Kono 1987 / Brilliantov et al. 1996" + ("" if _clamp else " (force may go tensile)"),
@@ -283,8 +210,7 @@ for _clamp in (False, True):
                 "B calibrated by the first-order restitution e = 1 - 1.153449 B (K/m)^(2/5) v0^(1/5) "
                 "(Schwager & Pöschel, Phys. Rev. E 78 (2008) 051304)."),
         validity="first order in b = B (K/m)^(2/5) v0^(1/5): b ≲ 0.1 (e ≳ 0.9); far off at apple-like e ≈ 0.5",
-        family=forces.KUWABARA_KONO, clamp=_clamp, published=_kk_published, group=_kk_group,
-        from_group=_kk_from_group,
+        family=forces.KUWABARA_KONO, clamp=_clamp, published=laws.kuwabara_kono_first_order,
         note="" if _clamp else "Without the clamp the force turns tensile before δ returns to 0."))
 
 

@@ -1,4 +1,4 @@
-"""Figures (optional extra ``plot``: matplotlib is imported only here).
+"""The four-panel figure of single impacts.
 
 ``impact_figure`` draws the paper's Figures 4–7 as one four-panel figure:
 δ(t) (Fig 4), δ̇(t) (Fig 5), F(δ) (Fig 6) and F(t) (Fig 7), for one or several
@@ -9,16 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-
-def _pyplot():
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg", force=False) if not matplotlib.get_backend().lower().startswith("module") else None
-        import matplotlib.pyplot as plt
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise ImportError("plotting needs matplotlib: pip install 'fruitimpact[plot]'") from exc
-    return plt
+from ._backend import _pyplot
 
 
 def _label(result) -> str:
@@ -61,10 +52,3 @@ def impact_figure(results, labels: Sequence[str] | None = None, title: str | Non
     if title:
         fig.suptitle(title)
     return fig
-
-
-def save_figure(fig, path) -> None:
-    """Save ``fig``; the format (PNG, SVG, PDF) follows the file extension."""
-    plt = _pyplot()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)

@@ -1,0 +1,14 @@
+"""Figures (optional extra ``plot``: matplotlib is imported only inside this package, on first use).
+
+* ``impact_figure``: the paper's Figures 4–7 of one or several impacts;
+* ``sweep_figure``, ``histogram_figure``: a sweep over its grid, a population's histograms;
+* ``restitution_figure``: achieved against requested restitution of every damping law;
+* ``save_figure``: writes any of them atomically, the format chosen by the extension.
+"""
+
+from ._backend import save_figure
+from .impact import impact_figure
+from .models import restitution_figure
+from .runs import histogram_figure, sweep_figure
+
+__all__ = ["histogram_figure", "impact_figure", "restitution_figure", "save_figure", "sweep_figure"]

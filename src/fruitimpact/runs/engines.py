@@ -1,0 +1,90 @@
+"""Where chunks run: in this process, or as tasks on a Dask cluster.
+
+An engine's ``run(plan, payloads, workdir, done)`` evaluates every (index,
+payload) of ``payloads`` with ``chunks.run_chunk`` and calls ``done(result)``
+in the driving process as each chunk completes.  The output and the summary
+are the same whichever engine ran the chunks.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from . import chunks
+from .plan import RunError
+
+#: A Dask scheduler address: ``tcp://host:port``, ``host:port`` (no spaces).
+_ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+.-]*://)?[^\s/:]+(?::\d{1,5})?(?:/\S*)?$")
+
+
+def check_scheduler(address: str) -> str:
+    """``address`` if it looks like a Dask scheduler address, else ``ValueError``."""
+    if not _ADDRESS.match(address or ""):
+        raise ValueError(f"a scheduler address is like tcp://10.0.0.5:8786 or 10.0.0.5:8786; got {address!r}")
+    return address
+
+
+@dataclass(frozen=True)
+class InProcessEngine:
+    """Chunks one after the other in this process (the compiled kernels use every core); each
+    chunk's rows come back to the driver, which writes them straight into the output."""
+
+    name = "inprocess"
+
+    def run(self, plan, payloads, workdir: str, done) -> None:
+        for index, payload in payloads:
+            done(chunks.run_chunk(plan, index, payload, workdir, keep_rows=True))
+
+
+@dataclass(frozen=True)
+class DaskEngine:
+    """Chunks as tasks on a Dask cluster: ``scheduler`` (address) or a local cluster of ``workers``
+    single-threaded worker processes.  Each task evaluates one chunk with single-threaded kernels
+    and writes its part file itself (the work folder must be shared with the workers); the driver
+    reads the parts back, verified, into the output."""
+
+    scheduler: str | None = None
+    workers: int = 2
+    name = "dask"
+
+    def __post_init__(self):
+        if self.scheduler is not None:
+            check_scheduler(self.scheduler)
+
+    def run(self, plan, payloads, workdir: str, done) -> None:
+        import logging
+
+        try:
+            from distributed import Client, LocalCluster, as_completed
+        except ImportError:
+            raise RunError("--engine dask needs dask: pip install 'fruitimpact[dask]'") from None
+        cluster = None
+        if self.scheduler is None:
+            cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=":0", silence_logs=logging.ERROR)
+            client = Client(cluster)
+        else:
+            try:
+                client = Client(self.scheduler, timeout="10s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise RunError(f"argument --scheduler: cannot connect to {self.scheduler!r} "
+                               f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") from None
+        try:
+            slots = max(1, sum(client.nthreads().values()))
+            shared = client.scatter(plan, broadcast=True)
+            running = as_completed(with_results=True)
+            for index, payload in payloads:
+                running.add(client.submit(chunks.run_chunk, shared, index, payload, workdir, 1, pure=False))
+                while running.count() >= 2 * slots:  # bounded: at most two chunks per worker thread in flight
+                    done(next(running)[1])
+            for _, result in running:
+                done(result)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+#: Engines by name.
+ENGINES = {"inprocess": InProcessEngine, "dask": DaskEngine}

@@ -1,0 +1,95 @@
+"""What a run produced: status counts, and for populations exact streamed statistics,
+threshold counts and percentiles, merged from the chunks' summaries."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..quantities import CHARACTERISTICS
+
+
+@dataclass
+class RunSummary:
+    """What a run produced: rows per status (``statuses``; ``ok``, ``invalid``, ``failed`` also as
+    fields); for populations statistics, threshold counts and the percentile method."""
+
+    kind: str
+    rows: int
+    ok: int
+    invalid: int
+    failed: int
+    output: str | None = None
+    resumed_chunks: int = 0
+    statistics: dict = field(default_factory=dict)
+    thresholds: list = field(default_factory=list)
+    percentiles: dict = field(default_factory=dict)  # method, sample size, exact or not
+    sample: np.ndarray | None = None  # the percentile sample, one column per statistic
+    columns: dict = field(default_factory=dict)  # columns read back for figures (keep_columns)
+    statuses: dict = field(default_factory=dict)  # rows per status, every status evaluate reported
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "rows": self.rows, "ok": self.ok, "invalid": self.invalid, "failed": self.failed,
+                "statuses": self.statuses, "output": self.output, "resumed_chunks": self.resumed_chunks,
+                "percentile_method": self.percentiles, "statistics": self.statistics, "thresholds": self.thresholds}
+
+
+def add_statuses(records) -> dict[str, int]:
+    """Rows per status over the chunk ``records``."""
+    total: dict[str, int] = {}
+    for record in records:
+        for status, count in record["statuses"].items():
+            total[status] = total.get(status, 0) + int(count)
+    return total
+
+
+def _merge_moments(moments: np.ndarray) -> tuple[int, float, float]:
+    """Count, mean and M2 of chunks' (n, mean, M2) rows, merged exactly (Chan et al.)."""
+    n, mean, m2 = 0, 0.0, 0.0
+    for cn, cmean, cm2 in moments[:, :3]:
+        if cn == 0:
+            continue
+        total = n + cn
+        delta = cmean - mean
+        mean += delta * cn / total
+        m2 += cm2 + delta * delta * n * cn / total
+        n = total
+    return int(n), mean, m2
+
+
+def _percentiles(column: np.ndarray, percentiles) -> dict:
+    """``numpy.percentile`` (linear) of the finite values of ``column``, one partition for all."""
+    column = column[np.isfinite(column)]
+    if not column.size:
+        return {f"{p:g}": math.nan for p in percentiles}
+    return {f"{p:g}": float(v) for p, v in zip(percentiles, np.percentile(column, list(percentiles)))}
+
+
+def combine(summaries: list, plan, percentiles, ok: int) -> dict:
+    """Merge chunk summaries (in chunk order) into statistics, threshold counts and percentiles
+    of the ``ok`` rows."""
+    moments = np.stack([s["moments"] for s in summaries])  # chunks × stats × (n, mean, m2, min, max)
+    sample = np.concatenate([s["sample"] for s in summaries]) if summaries else np.empty((0, len(plan.stats)))
+    stats = {}
+    for j, name in enumerate(plan.stats):
+        n, mean, m2 = _merge_moments(moments[:, j])
+        stats[name] = {
+            "unit": CHARACTERISTICS[name].si_unit, "count": n,
+            "mean": mean if n else math.nan, "sd": math.sqrt(m2 / (n - 1)) if n > 1 else math.nan,
+            "min": float(moments[:, j, 3].min()) if n else math.nan,
+            "max": float(moments[:, j, 4].max()) if n else math.nan,
+            "percentiles": _percentiles(sample[:, j], percentiles),
+        }
+    threshold_counts = np.sum([s["thresholds"] for s in summaries], axis=0) if plan.thresholds else []
+    thresholds = [{"threshold": t.text, "characteristic": t.name, "op": t.op, "value": t.value,
+                   "unit": CHARACTERISTICS[t.name].si_unit, "count": int(c), "of": ok,
+                   "share": int(c) / ok if ok else math.nan}
+                  for t, c in zip(plan.thresholds, threshold_counts)]
+    exact = plan.sample_probability >= 1.0
+    method = {"exact": exact, "sample_rows": int(sample.shape[0]), "method": "numpy.percentile, linear interpolation",
+              "note": ("exact: every ok row" if exact else
+                       f"estimate from a seeded uniform sample of {sample.shape[0]} ok rows "
+                       f"(each row kept with probability {plan.sample_probability:.3g})")}
+    return {"statistics": stats, "thresholds": thresholds, "percentiles": method, "sample": sample}

@@ -1,0 +1,104 @@
+"""The shape of the code (issue 6, items 21–25): one table of quantities drives options,
+columns, validation and results; outputs are named; the numeric core imports no I/O,
+tables, plots or CLI (an import-linter contract); ``fruitimpact --help`` starts no numba.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fruitimpact import Characteristics, simulate
+from fruitimpact.batch import OUTPUT_COLUMNS, evaluate
+from fruitimpact.cli import build_parser
+from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS
+from fruitimpact.quantities import CHARACTERISTIC_NAMES, INPUTS, OUTPUTS
+from fruitimpact.validation import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+SOURCE = ROOT / "src" / "fruitimpact"
+
+
+def _options(command: str) -> set[str]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    return {option for action in sub._actions for option in action.option_strings}
+
+
+@pytest.mark.parametrize("command", ["simulate", "sweep", "population"])
+def test_every_input_of_the_table_is_an_option(command):
+    options = _options(command)
+    missing = [q.option for q in INPUTS.values() if q.option not in options]
+    assert not missing, missing
+
+
+def test_every_input_of_the_table_is_a_batch_column():
+    for name, quantity in INPUTS.items():
+        value = quantity.default if quantity.default is not None else {
+            "stiffness": 8e5, "velocity": 1.0, "drop_height": 0.1, "restitution": 0.5, "alpha": 0.1,
+            "damping": 1e5}[name]
+        result = evaluate({name: [value]})
+        assert result.loc[0, "status"] == "ok", (name, result.loc[0, "message"])
+
+
+def test_outputs_are_named_by_the_table():
+    assert CHARACTERISTIC_NAMES == CHARACTERISTIC_COLUMNS
+    assert set(OUTPUTS) <= set(OUTPUT_COLUMNS)
+    fields = {f.name for f in dataclasses.fields(Characteristics)}
+    assert set(CHARACTERISTIC_NAMES) <= fields
+    report = simulate().to_dict()
+    assert set(CHARACTERISTIC_NAMES) <= set(report)
+
+
+@pytest.mark.parametrize("name", [q.name for q in INPUTS.values() if q.numeric])
+def test_refused_inputs_name_their_argument(name):
+    with pytest.raises(InputError) as info:
+        if name in ("mass", "diameter", "modulus", "poisson", "stiffness"):
+            from fruitimpact import Fruit
+
+            Fruit(**{name: "not a number"})
+        elif name.startswith("surface_"):
+            from fruitimpact import Surface
+
+            Surface(**{name[len("surface_"):]: "not a number"})
+        else:
+            simulate(**{name: "not a number"})
+    assert info.value.argument == name
+    assert str(info.value).startswith(name + " ")
+
+
+def test_no_family_dispatch_by_if_chains_outside_the_engine():
+    """Force families are records (models.families); only the compiled engine branches on codes."""
+    offenders = []
+    for path in SOURCE.rglob("*.py"):
+        if "engine" in path.parts:
+            continue
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            if re.search(r"\bfamily\s*==|==\s*forces\.", line):
+                offenders.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
+    assert not offenders, offenders
+
+
+def test_import_contracts_hold():
+    """The import-linter contracts of pyproject.toml (the numeric core imports no pandas, matplotlib,
+    pyarrow, CLI, runs or plotting; plotting only where figures are drawn)."""
+    lint = Path(sys.executable).with_name("lint-imports")
+    command = [str(lint)] if lint.exists() else [sys.executable, "-m", "importlinter.cli"]
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "0 broken" in done.stdout
+
+
+def test_help_starts_no_numba_and_no_pandas():
+    code = ("import sys\nfrom fruitimpact.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            "for name in ('numba', 'pandas', 'matplotlib', 'pyarrow'):\n"
+            "    print(name, name in sys.modules)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    loaded = dict(line.split() for line in done.stdout.splitlines()
+                  if len(line.split()) == 2 and line.split()[1] in ("True", "False"))
+    assert loaded == {"numba": "False", "pandas": "False", "matplotlib": "False", "pyarrow": "False"}, done.stdout
