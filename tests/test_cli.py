@@ -13,16 +13,12 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.special import beta
 
-from fruitimpact.cli import main
 
 G = 9.80665  # standard gravity, m/s^2
 PREFIX = "fruitimpact simulate: error: "
@@ -38,54 +34,13 @@ DEFAULT_INPUTS = dict(mass=0.115, diameter=0.065, modulus=3e6, poisson=0.37, vel
 
 
 # --------------------------------------------------------------------------- helpers
-def run(capsys, *argv):
-    """(exit status, stdout, stderr) of ``fruitimpact simulate ARGV`` in-process."""
-    status = main(["simulate", *map(str, argv)])
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def run_json(capsys, *argv) -> dict:
-    status, out, err = run(capsys, *argv, "--json")
-    assert status == 0, err
-    report = json.loads(out)
-    # stderr holds nothing but the warnings the object carries (a contact beyond Hertz's range ...)
-    assert err.splitlines() == [f"fruitimpact simulate: warning: {w}" for w in report["warnings"]], err
-    return report
-
-
-def error_line(capsys, *argv) -> str:
-    """The single stderr line of a rejected command (asserts exit 2, one line, no traceback)."""
-    status, out, err = run(capsys, *argv)
-    assert status == 2, (status, out, err)
-    assert out == ""
-    assert "Traceback" not in err
-    lines = err.splitlines()
-    assert len(lines) == 1, err
-    assert err.endswith("\n")
-    return lines[0]
-
-
 def characteristics(result: dict) -> dict:
     return {k: result[k] for k in CHARACTERISTIC_KEYS}
 
 
-def console_script() -> list[str]:
-    """The installed ``fruitimpact`` entry point (beside this interpreter, else on PATH)."""
-    beside = Path(sys.executable).with_name("fruitimpact")
-    found = str(beside) if beside.exists() else shutil.which("fruitimpact")
-    assert found, "console script 'fruitimpact' is not installed (pip install -e .)"
-    return [found]
-
-
-def run_script(*argv):
-    return subprocess.run([*console_script(), "simulate", *argv], capture_output=True, text=True,
-                          timeout=60)
-
-
 # --------------------------------------------------------------------------- JSON contract
-def test_json_has_every_characteristic_as_a_finite_number(capsys):
-    result = run_json(capsys)
+def test_json_has_every_characteristic_as_a_finite_number(cli):
+    result = cli.json("simulate")
     for key in CHARACTERISTIC_KEYS:
         assert key in result, key
         value = result[key]
@@ -98,8 +53,8 @@ def test_json_has_every_characteristic_as_a_finite_number(capsys):
     assert 0 < result["time_to_peak"] < result["contact_duration"]
 
 
-def test_json_includes_the_inputs(capsys):
-    result = run_json(capsys)
+def test_json_includes_the_inputs(cli):
+    result = cli.json("simulate")
     for key, value in DEFAULT_INPUTS.items():
         assert result[key] == pytest.approx(value, rel=1e-15), key
     assert result["model"] == "hunt-crossley"
@@ -109,8 +64,8 @@ def test_json_includes_the_inputs(capsys):
     assert result["success"] is True
 
 
-def test_json_is_one_strict_json_object(capsys):
-    status, out, err = run(capsys, "--json")
+def test_json_is_one_strict_json_object(cli):
+    status, out, err = cli.run("simulate", "--json")
     assert status == 0 and err == ""
     # strict JSON: no NaN/Infinity tokens
     parsed = json.loads(out, parse_constant=lambda token: pytest.fail(f"non-strict JSON token {token}"))
@@ -130,9 +85,9 @@ def test_json_is_one_strict_json_object(capsys):
     (["--method", "rk4", "--step", "0.1ms", "--velocity", "3.6km/h"],
      ["--method", "rk4", "--step", "1e-4", "--velocity", "1"]),
 ])
-def test_units_give_the_same_result_as_si_numbers(capsys, with_units, si):
-    a = run_json(capsys, *with_units)
-    b = run_json(capsys, *si)
+def test_units_give_the_same_result_as_si_numbers(cli, with_units, si):
+    a = cli.json("simulate", *with_units)
+    b = cli.json("simulate", *si)
     assert a.keys() == b.keys()
     for key, value in a.items():
         if isinstance(value, float):
@@ -142,16 +97,16 @@ def test_units_give_the_same_result_as_si_numbers(capsys, with_units, si):
     assert a["inputs"]["step"] == pytest.approx(b["inputs"]["step"], rel=1e-12)
 
 
-def test_step_with_unit_is_recorded_in_si(capsys):
-    result = run_json(capsys, "--step", "10ms")
+def test_step_with_unit_is_recorded_in_si(cli):
+    result = cli.json("simulate", "--step", "10ms")
     assert result["inputs"]["step"] == pytest.approx(0.01, rel=1e-15)
-    result = run_json(capsys, "--method", "rk4", "--step", "50us")
+    result = cli.json("simulate", "--method", "rk4", "--step", "50us")
     assert result["step"] == pytest.approx(5e-5, rel=1e-12)
 
 
 # --------------------------------------------------------------------------- velocity, alpha, stiffness
-def test_drop_height_gives_free_fall_velocity(capsys):
-    result = run_json(capsys, "--drop-height", "30cm")
+def test_drop_height_gives_free_fall_velocity(cli):
+    result = cli.json("simulate", "--drop-height", "30cm")
     assert result["velocity"] == pytest.approx(math.sqrt(2 * G * 0.3), rel=1e-15)
     assert result["drop_height"] == pytest.approx(0.3, rel=1e-15)
     # the restitution still applies at that velocity
@@ -159,28 +114,28 @@ def test_drop_height_gives_free_fall_velocity(capsys):
     assert result["exit_velocity"] == pytest.approx(0.577 * math.sqrt(2 * G * 0.3), rel=1e-8)
 
 
-def test_alpha_zero_is_elastic(capsys):
+def test_alpha_zero_is_elastic(cli):
     """α = 0 is λ = 0 (eq 5): the elastic Hertz impact.  Any α ≥ 0: test_damping_inputs.py."""
-    result = run_json(capsys, "--alpha", "0")
+    result = cli.json("simulate", "--alpha", "0")
     assert result["target_restitution"] is None
     assert result["restitution"] == pytest.approx(1.0, abs=1e-12)
     assert result["damping"] == 0.0
 
 
-def test_alpha_with_paper_calibration_is_hunt_crossley_eq6(capsys):
+def test_alpha_with_paper_calibration_is_hunt_crossley_eq6(cli):
     """Paper calibration of hunt-crossley: λ = (3/2) α k_c (eqs 5, 6, 11)."""
-    result = run_json(capsys, "--alpha", "0.3", "--velocity", "1.2", "--calibration", "paper")
+    result = cli.json("simulate", "--alpha", "0.3", "--velocity", "1.2", "--calibration", "paper")
     assert result["damping_factor"] == pytest.approx(1.5 * 0.3, rel=1e-12)
     assert result["damping"] == pytest.approx(1.5 * 0.3 * result["stiffness"], rel=1e-12)
 
 
-def test_stiffness_overrides_modulus_and_poisson(capsys):
-    direct = run_json(capsys, "--stiffness", "1.2e6")
-    overridden = run_json(capsys, "--stiffness", "1.2e6", "--modulus", "50MPa", "--poisson", "0.1")
+def test_stiffness_overrides_modulus_and_poisson(cli):
+    direct = cli.json("simulate", "--stiffness", "1.2e6")
+    overridden = cli.json("simulate", "--stiffness", "1.2e6", "--modulus", "50MPa", "--poisson", "0.1")
     assert direct["stiffness"] == 1.2e6
     assert overridden["stiffness"] == 1.2e6
     assert characteristics(direct) == characteristics(overridden)
-    hertz = run_json(capsys)
+    hertz = cli.json("simulate")
     assert hertz["stiffness"] != pytest.approx(1.2e6, rel=1e-3)
     assert hertz["peak_force"] != pytest.approx(direct["peak_force"], rel=1e-6)
 
@@ -198,8 +153,8 @@ FRUITS = [
 
 
 @pytest.mark.parametrize("argv", FRUITS, ids=["jonathan", "big", "small-chen", "chen-paper", "rk4"])
-def test_physics_consistency(capsys, argv):
-    r = run_json(capsys, *argv)
+def test_physics_consistency(cli, argv):
+    r = cli.json("simulate", *argv)
     m, v, e = r["mass"], r["velocity"], r["restitution"]
     # λ = c·k_c
     assert r["damping"] == pytest.approx(r["stiffness"] * r["damping_factor"], rel=1e-12)
@@ -219,16 +174,16 @@ def test_physics_consistency(capsys, argv):
 @pytest.mark.parametrize("model", ["hunt-crossley", "chen"])
 @pytest.mark.parametrize("k", [0.2, 0.577, 0.9, 1.0])
 @pytest.mark.parametrize("velocity", ["0.5", "3"])
-def test_exact_calibration_hits_requested_restitution(capsys, model, k, velocity):
-    r = run_json(capsys, "--model", model, "--calibration", "exact", "--restitution", k, "--velocity", velocity)
+def test_exact_calibration_hits_requested_restitution(cli, model, k, velocity):
+    r = cli.json("simulate", "--model", model, "--calibration", "exact", "--restitution", k, "--velocity", velocity)
     assert r["restitution"] == pytest.approx(k, abs=1e-8)
     assert r["exit_velocity"] == pytest.approx(k * float(velocity), rel=1e-8)
 
 
-def test_paper_calibration_differs_from_exact(capsys):
+def test_paper_calibration_differs_from_exact(cli):
     """Sanity check that --calibration is honoured: the published first-order laws miss k = 0.577."""
     for model in ("hunt-crossley", "chen"):
-        paper = run_json(capsys, "--model", model, "--calibration", "paper")
+        paper = cli.json("simulate", "--model", model, "--calibration", "paper")
         assert paper["calibration"] == "paper"
         assert abs(paper["restitution"] - 0.577) > 0.01
 
@@ -245,8 +200,8 @@ def test_hertz_duration_constant():
     ["--velocity", "3", "--mass", "0.3", "--stiffness", "2e6"],
     ["--drop-height", "5cm", "--restitution", "0.3"],  # restitution is ignored by hertz
 ])
-def test_hertz_closed_forms(capsys, argv):
-    r = run_json(capsys, "--model", "hertz", *argv)
+def test_hertz_closed_forms(cli, argv):
+    r = cli.json("simulate", "--model", "hertz", *argv)
     m, v, k_c = r["mass"], r["velocity"], r["stiffness"]
     assert r["restitution"] == pytest.approx(1.0, abs=1e-12)
     assert r["damping"] == 0.0
@@ -269,7 +224,7 @@ def _read_csv(path: Path, min_rows: int = 100):
     return data.T
 
 
-def test_csv_curves_match_characteristics(capsys, tmp_path):
+def test_csv_curves_match_characteristics(cli, tmp_path):
     """Accurate solver: the CSV samples F(t) on a uniform grid over [0, T].
 
     Tolerance: the sampled maximum cannot exceed F_max (beyond the 12
@@ -281,7 +236,7 @@ def test_csv_curves_match_characteristics(capsys, tmp_path):
     is ~1e-8).
     """
     path = tmp_path / "curves.csv"
-    r = run_json(capsys, "--csv", path)
+    r = cli.json("simulate", "--csv", path)
     t, deflection, rate, force = _read_csv(path)
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     assert t[-1] == pytest.approx(r["contact_duration"], rel=1e-10)
@@ -301,19 +256,19 @@ def test_csv_curves_match_characteristics(capsys, tmp_path):
     assert rate[-1] == pytest.approx(-r["exit_velocity"], rel=1e-6)
 
 
-def test_csv_rk4_peak_is_a_grid_sample(capsys, tmp_path):
+def test_csv_rk4_peak_is_a_grid_sample(cli, tmp_path):
     """RK4 reads F_max off its own grid, so the CSV maximum equals it to the CSV's 12 digits."""
     path = tmp_path / "rk4.csv"
-    r = run_json(capsys, "--method", "rk4", "--step", "1e-4", "--csv", path)
+    r = cli.json("simulate", "--method", "rk4", "--step", "1e-4", "--csv", path)
     t, _, _, force = _read_csv(path, min_rows=50)  # 6.3 ms contact at 0.1 ms
     assert np.allclose(np.diff(t)[:-1], 1e-4, rtol=1e-9, atol=0)  # fixed step (last may be partial)
     assert force.max() == pytest.approx(r["peak_force"], rel=1e-11)
     assert t[int(np.argmax(force))] == pytest.approx(r["time_to_peak"], rel=1e-11)
 
 
-def test_csv_in_table_mode_is_announced(capsys, tmp_path):
+def test_csv_in_table_mode_is_announced(cli, tmp_path):
     path = tmp_path / "c.csv"
-    status, out, err = run(capsys, "--csv", path)
+    status, out, err = cli.run("simulate", "--csv", path)
     assert status == 0 and err == ""
     assert path.exists()
     assert f"curves written to {path}" in out
@@ -324,10 +279,10 @@ MAGIC = {"png": b"\x89PNG\r\n\x1a\n", "svg": None, "pdf": b"%PDF"}
 
 
 @pytest.mark.parametrize("ext", ["png", "svg", "pdf"])
-def test_plot_writes_figure(capsys, tmp_path, ext):
+def test_plot_writes_figure(cli, tmp_path, ext):
     pytest.importorskip("matplotlib")
     path = tmp_path / f"impact.{ext}"
-    status, out, err = run(capsys, "--plot", path)
+    status, out, err = cli.run("simulate", "--plot", path)
     assert status == 0, err
     assert path.stat().st_size > 1000
     head = path.read_bytes()[:4096]
@@ -339,10 +294,10 @@ def test_plot_writes_figure(capsys, tmp_path, ext):
 
 
 # --------------------------------------------------------------------------- readable table
-def test_table_lists_the_characteristics(capsys):
-    status, out, err = run(capsys)
+def test_table_lists_the_characteristics(cli):
+    status, out, err = cli.run("simulate")
     assert status == 0 and err == ""
-    r = run_json(capsys)
+    r = cli.json("simulate")
     for label in ("peak force", "time to peak", "contact duration", "max deflection", "exit velocity",
                   "restitution", "absorbed energy", "firmness C ", "firmness C*", "contact pressure",
                   "contact radius"):
@@ -415,8 +370,8 @@ def _case_id(case):
 
 
 @pytest.mark.parametrize("argv, options, allowed", BAD_CASES, ids=[_case_id(c) for c in BAD_CASES])
-def test_bad_input_is_one_line_exit_2(capsys, argv, options, allowed):
-    line = error_line(capsys, *argv)
+def test_bad_input_is_one_line_exit_2(cli, argv, options, allowed):
+    line = cli.error("simulate", *argv)
     assert line.startswith(PREFIX), line
     if len(options) == 1:
         assert f"argument {options[0]}: " in line, line
@@ -428,26 +383,26 @@ def test_bad_input_is_one_line_exit_2(capsys, argv, options, allowed):
 
 
 @pytest.mark.parametrize("argv", [["--mass"], ["--bogus", "1"], ["--json=yes"]])
-def test_argparse_errors_are_one_line_exit_2(capsys, argv):
-    status, out, err = run(capsys, *argv)
+def test_argparse_errors_are_one_line_exit_2(cli, argv):
+    status, out, err = cli.run("simulate", *argv)
     assert status == 2
     assert len(err.splitlines()) == 1 and "Traceback" not in err
     assert "error:" in err
 
 
 # --------------------------------------------------------------------------- the real console script
-def test_script_default_run():
-    proc = run_script()
+def test_script_default_run(script):
+    proc = script("simulate", )
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""
     assert "peak force" in proc.stdout and "contact duration" in proc.stdout
 
 
-def test_script_json_matches_in_process(capsys):
-    proc = run_script("--json", "--mass", "115g")
+def test_script_json_matches_in_process(cli, script):
+    proc = script("simulate", "--json", "--mass", "115g")
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""
-    assert json.loads(proc.stdout) == run_json(capsys)
+    assert json.loads(proc.stdout) == cli.json("simulate")
 
 
 @pytest.mark.parametrize("argv, option", [
@@ -456,8 +411,8 @@ def test_script_json_matches_in_process(capsys):
     (["--velocity", "1", "--drop-height", "30cm"], "--drop-height"),
     (["--diameter", "5furlongs"], "--diameter"),
 ])
-def test_script_bad_input(argv, option):
-    proc = run_script(*argv)
+def test_script_bad_input(argv, option, script):
+    proc = script("simulate", *argv)
     assert proc.returncode == 2
     assert proc.stdout == ""
     assert "Traceback" not in proc.stderr
@@ -467,16 +422,50 @@ def test_script_bad_input(argv, option):
 
 
 # --------------------------------------------------------------------------- coarse RK4 step
-def test_rk4_step_longer_than_contact_is_refused(capsys):
+def test_rk4_step_longer_than_contact_is_refused(cli):
     # a step that leaves fewer than 20 steps per contact is bad input, not a silent success
-    status, out, err = run(capsys, "--method", "rk4", "--step", "10ms", "--json")
+    status, out, err = cli.run("simulate", "--method", "rk4", "--step", "10ms", "--json")
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and "--step" in err and "at least 20 steps" in err
 
 
-def test_plot_overlays_other_models(capsys, tmp_path):
+def test_plot_overlays_other_models(cli, tmp_path):
     path = tmp_path / "overlay.png"
-    status, out, err = run(capsys, "--plot", str(path), "--overlay", "chen:paper", "--overlay", "hunt-crossley:paper:rk4")
+    status, out, err = cli.run("simulate", "--plot", str(path), "--overlay", "chen:paper", "--overlay", "hunt-crossley:paper:rk4")
     assert status == 0 and path.stat().st_size > 10_000
-    status, out, err = run(capsys, "--plot", str(path), "--overlay", "chen:bogus")
+    status, out, err = cli.run("simulate", "--plot", str(path), "--overlay", "chen:bogus")
     assert status == 2 and "--overlay" in err and err.count("\n") == 1
+
+
+# --------------------------------------------------------------------------- Ctrl-C
+def test_ctrl_c_during_start_up_is_one_line(cli, monkeypatch):
+    """A KeyboardInterrupt while the parser is built (imports, registries) is one line, exit 130."""
+    import fruitimpact.cli as package
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(package, "build_parser", interrupted)
+    status, out, err = cli.run("simulate")
+    assert status == 130 and out == ""
+    assert err == "fruitimpact simulate: interrupted\n"
+
+
+@pytest.mark.parametrize("delay", [0.15, 0.3, 0.6])
+def test_sigint_to_the_console_script_never_shows_a_traceback(delay):
+    """A real SIGINT at several moments of `fruitimpact simulate` (imports, numba start-up, the impact)."""
+    import signal
+    import subprocess
+    import time
+
+    from conftest import console_script
+
+    process = subprocess.Popen([console_script(), "simulate", "--model", "tsuji-clamped"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=60)
+    assert "Traceback" not in err, err
+    assert process.returncode in (0, 130), (process.returncode, err)
+    if process.returncode == 130:
+        assert err.strip().endswith("interrupted") and len(err.strip().splitlines()) == 1

@@ -14,36 +14,19 @@ import pandas as pd
 import pytest
 
 from fruitimpact import Fruit, runs, simulate
-from fruitimpact.cli import main
 from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS
 
 G = 9.80665
 
 
-def cli(capsys, *argv):
-    status = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def ok(capsys, *argv) -> str:
-    status, out, err = cli(capsys, *argv)
-    assert status == 0, err
-    assert err == ""  # stderr is not a terminal: no progress bar
-    return out
-
-
-def error_line(capsys, *argv) -> str:
-    status, out, err = cli(capsys, *argv)
-    assert status == 2, (status, out, err)
-    assert "Traceback" not in err
-    lines = err.splitlines()
-    assert len(lines) == 1, err
-    return lines[0]
-
-
 def read(path) -> pd.DataFrame:
-    return pd.read_parquet(path) if str(path).endswith(".parquet") else pd.read_csv(path)
+    """The output's rows; text columns as plain strings (Parquet keeps them dictionary-encoded,
+    with categories in the order each chunk met them)."""
+    frame = pd.read_parquet(path) if str(path).endswith(".parquet") else pd.read_csv(path)
+    for name in frame.columns:
+        if isinstance(frame[name].dtype, pd.CategoricalDtype):
+            frame[name] = frame[name].astype(str)
+    return frame
 
 
 # --------------------------------------------------------------------------- batch
@@ -66,10 +49,10 @@ def expected_single(row: dict):
     return simulate(fruit, model=row["model"], method=row["method"], step=row["step"], **kwargs).characteristics
 
 
-def test_batch_every_row_accounted_valid_rows_equal_simulate(tmp_path, capsys):
+def test_batch_every_row_accounted_valid_rows_equal_simulate(tmp_path, cli):
     source = tmp_path / "in.csv"
     source.write_text(BATCH_CSV)
-    out = ok(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 3)
+    out = cli.ok("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 3)
     assert "8 rows: 4 ok, 4 invalid, 0 failed" in out
     result = read(tmp_path / "out.csv")
     assert list(result["row"]) == list(range(8))
@@ -98,14 +81,14 @@ def test_batch_every_row_accounted_valid_rows_equal_simulate(tmp_path, capsys):
     assert not list(tmp_path.glob("*.parts"))  # work directory removed
 
 
-def test_batch_csv_and_parquet_in_and_out_agree(tmp_path, capsys):
+def test_batch_csv_and_parquet_in_and_out_agree(tmp_path, cli):
     source = tmp_path / "in.csv"
     source.write_text(BATCH_CSV)
     frame = pd.read_csv(source, dtype=str)  # the same cells (strings with units) in Parquet
     frame.to_parquet(tmp_path / "in.parquet")
-    ok(capsys, "batch", source, "-o", tmp_path / "a.parquet", "--chunk-size", 5)
-    ok(capsys, "batch", tmp_path / "in.parquet", "-o", tmp_path / "b.csv", "--chunk-size", 3)
-    ok(capsys, "batch", tmp_path / "in.parquet", "-o", tmp_path / "c.parquet")
+    cli.ok("batch", source, "-o", tmp_path / "a.parquet", "--chunk-size", 5)
+    cli.ok("batch", tmp_path / "in.parquet", "-o", tmp_path / "b.csv", "--chunk-size", 3)
+    cli.ok("batch", tmp_path / "in.parquet", "-o", tmp_path / "c.parquet")
     a, b, c = read(tmp_path / "a.parquet"), read(tmp_path / "b.csv"), read(tmp_path / "c.parquet")
     assert len(a) == len(b) == len(c) == 8
     pd.testing.assert_frame_equal(a, c)
@@ -114,20 +97,20 @@ def test_batch_csv_and_parquet_in_and_out_agree(tmp_path, capsys):
     assert list(a["status"]) == list(b["status"])
 
 
-def test_batch_refuses_unknown_columns_and_formats(tmp_path, capsys):
+def test_batch_refuses_unknown_columns_and_formats(tmp_path, cli):
     (tmp_path / "in.csv").write_text("mass,velocty\n0.1,1\n")
-    line = error_line(capsys, "batch", tmp_path / "in.csv", "-o", tmp_path / "o.csv")
+    line = cli.error("batch", tmp_path / "in.csv", "-o", tmp_path / "o.csv")
     assert line.startswith("fruitimpact batch: error: argument IN:") and "'velocty'" in line
     (tmp_path / "in.txt").write_text("mass\n0.1\n")
-    assert "must end in .csv or .parquet" in error_line(capsys, "batch", tmp_path / "in.txt", "-o", tmp_path / "o.csv")
+    assert "must end in .csv or .parquet" in cli.error("batch", tmp_path / "in.txt", "-o", tmp_path / "o.csv")
     (tmp_path / "in.csv").write_text("mass\n0.1\n")
-    line = error_line(capsys, "batch", tmp_path / "in.csv", "-o", tmp_path / "o.xlsx")
+    line = cli.error("batch", tmp_path / "in.csv", "-o", tmp_path / "o.xlsx")
     assert "argument -o/--output" in line
 
 
 # --------------------------------------------------------------------------- sweep
-def test_sweep_grid_size_order_and_values(tmp_path, capsys):
-    out = ok(capsys, "sweep", "--velocity", "0.3:1.5:5", "--modulus", "2MPa:6MPa:3", "--mass", "150g",
+def test_sweep_grid_size_order_and_values(tmp_path, cli):
+    out = cli.ok("sweep", "--velocity", "0.3:1.5:5", "--modulus", "2MPa:6MPa:3", "--mass", "150g",
              "--model", "hunt-crossley,chen", "-o", tmp_path / "s.parquet", "--chunk-size", 7)
     assert "5 velocity × 3 modulus × 2 model; 30 rows: 30 ok" in out
     s = read(tmp_path / "s.parquet")
@@ -141,13 +124,13 @@ def test_sweep_grid_size_order_and_values(tmp_path, capsys):
     assert row.peak_force == pytest.approx(single.peak_force, rel=1e-9)
 
 
-def test_sweep_log_spacing_list_and_plots(tmp_path, capsys):
-    ok(capsys, "sweep", "--drop-height", "log:1cm:1m:5", "--restitution", "0.3,0.6", "-o", tmp_path / "s.csv",
+def test_sweep_log_spacing_list_and_plots(tmp_path, cli):
+    cli.ok("sweep", "--drop-height", "log:1cm:1m:5", "--restitution", "0.3,0.6", "-o", tmp_path / "s.csv",
        "--plot", tmp_path / "lines.png", "--characteristic", "contact_duration")
     s = read(tmp_path / "s.csv")
     np.testing.assert_allclose(sorted(set(s["drop_height"])), np.geomspace(0.01, 1.0, 5), rtol=1e-15)
     assert sorted(set(s["target_restitution"])) == [0.3, 0.6]
-    ok(capsys, "sweep", "--velocity", "0.5:1.5:12", "--modulus", "2MPa:6MPa:10", "--plot", tmp_path / "heat.png")
+    cli.ok("sweep", "--velocity", "0.5:1.5:12", "--modulus", "2MPa:6MPa:10", "--plot", tmp_path / "heat.png")
     assert (tmp_path / "lines.png").stat().st_size > 0 and (tmp_path / "heat.png").stat().st_size > 0
     assert not list(tmp_path.glob("*.parts")) and not list(tmp_path.glob(".fruitimpact-*"))
 
@@ -164,8 +147,8 @@ def test_sweep_log_spacing_list_and_plots(tmp_path, capsys):
     (["--velocity", "1:2:3", "--mass", "1:2:3", "--modulus", "1:2:3", "--plot", "x.png"], "argument --plot"),
     (["--velocity", "1:2:3"], "argument -o/--output: give -o OUT and/or --plot FILE"),
 ])
-def test_sweep_bad_input_one_line(capsys, argv, option):
-    line = error_line(capsys, "sweep", *argv)
+def test_sweep_bad_input_one_line(cli, argv, option):
+    line = cli.error("sweep", *argv)
     assert line.startswith("fruitimpact sweep: error: " + option), line
 
 
@@ -174,17 +157,17 @@ POP = ("population", "--mass", "normal(115g,10g)", "--velocity", "uniform(0.5m/s
        "--modulus", "lognormal(3MPa,0.2)", "--restitution", "truncnormal(0.6,0.1,0.4,0.8)", "--seed", 7)
 
 
-def population(tmp_path, capsys, name, *extra, rows=6000, chunk=2000):
+def population(tmp_path, cli, name, *extra, rows=6000, chunk=2000):
     out = tmp_path / name
-    report = json.loads(ok(capsys, *POP, "-n", rows, "--chunk-size", chunk, "-o", out, "--json", *extra))
+    report = json.loads(cli.ok(*POP, "-n", rows, "--chunk-size", chunk, "-o", out, "--json", *extra))
     return read(out), report
 
 
-def test_population_reproducible_and_independent_of_chunking(tmp_path, capsys):
-    a, report_a = population(tmp_path, capsys, "a.parquet")
-    b, _ = population(tmp_path, capsys, "b.parquet")
-    c, report_c = population(tmp_path, capsys, "c.csv", chunk=777)
-    d, _ = population(tmp_path, capsys, "d.parquet", chunk=6000)
+def test_population_reproducible_and_independent_of_chunking(tmp_path, cli):
+    a, report_a = population(tmp_path, cli, "a.parquet")
+    b, _ = population(tmp_path, cli, "b.parquet")
+    c, report_c = population(tmp_path, cli, "c.csv", chunk=777)
+    d, _ = population(tmp_path, cli, "d.parquet", chunk=6000)
     pd.testing.assert_frame_equal(a, b)
     pd.testing.assert_frame_equal(a, d)
     numeric = [k for k in a.columns if a[k].dtype.kind in "fi"]
@@ -192,14 +175,14 @@ def test_population_reproducible_and_independent_of_chunking(tmp_path, capsys):
     for name, stats in report_a["statistics"].items():  # merged moments agree across chunkings
         assert stats["mean"] == pytest.approx(report_c["statistics"][name]["mean"], rel=1e-12)
         assert stats["percentiles"] == report_c["statistics"][name]["percentiles"]
-    e, _ = population(tmp_path, capsys, "e.parquet", rows=2500)  # a smaller population is a prefix
+    e, _ = population(tmp_path, cli, "e.parquet", rows=2500)  # a smaller population is a prefix
     pd.testing.assert_frame_equal(e, a.iloc[:2500])
-    other = json.loads(ok(capsys, *POP[:-1], 8, "-n", 6000, "--json"))
+    other = json.loads(cli.ok(*POP[:-1], 8, "-n", 6000, "--json"))
     assert other["statistics"]["peak_force"]["mean"] != report_a["statistics"]["peak_force"]["mean"]
 
 
-def test_population_distributions(tmp_path, capsys):
-    a, _ = population(tmp_path, capsys, "a.parquet", rows=20000, chunk=20000)
+def test_population_distributions(tmp_path, cli):
+    a, _ = population(tmp_path, cli, "a.parquet", rows=20000, chunk=20000)
     assert a["mass"].mean() == pytest.approx(0.115, abs=3 * 0.01 / math.sqrt(20000))
     assert a["mass"].std() == pytest.approx(0.01, rel=0.03)
     assert a["velocity"].between(0.5, 1.5).all()
@@ -209,14 +192,14 @@ def test_population_distributions(tmp_path, capsys):
     assert a["target_restitution"].mean() == pytest.approx(0.6, abs=0.005)
     sample = pd.DataFrame({"m": ["100g", "120g", "0.14"], "other": [1, 2, 3]})
     sample.to_csv(tmp_path / "measured.csv", index=False)
-    s, report = population(tmp_path, capsys, "s.parquet", "--mass", f"sample({tmp_path / 'measured.csv'}:m)",
+    s, report = population(tmp_path, cli, "s.parquet", "--mass", f"sample({tmp_path / 'measured.csv'}:m)",
                            rows=3000)
     assert set(s["mass"]) == {0.1, 0.12, 0.14}
     assert report["ok"] == 3000
 
 
-def test_population_statistics_exact_for_small_n(tmp_path, capsys):
-    rows, report = population(tmp_path, capsys, "a.parquet", "--threshold", "peak_force>60N", "--threshold",
+def test_population_statistics_exact_for_small_n(tmp_path, cli):
+    rows, report = population(tmp_path, cli, "a.parquet", "--threshold", "peak_force>60N", "--threshold",
                               "firmness_c_star>=2e7", "--threshold", "contact_duration<6.5ms",
                               "--percentiles", "1,50,99.5")
     good = rows[rows["status"] == "ok"]
@@ -235,10 +218,10 @@ def test_population_statistics_exact_for_small_n(tmp_path, capsys):
     assert report["thresholds"][0]["share"] == counts[0] / len(good)
 
 
-def test_population_percentiles_estimated_from_sample_above_sample_size(capsys):
-    report = json.loads(ok(capsys, *POP, "-n", 6000, "--chunk-size", 2500, "--sample-size", 1000, "--json",
+def test_population_percentiles_estimated_from_sample_above_sample_size(cli):
+    report = json.loads(cli.ok(*POP, "-n", 6000, "--chunk-size", 2500, "--sample-size", 1000, "--json",
                            "--characteristics", "peak_force,max_deflection"))
-    exact = json.loads(ok(capsys, *POP, "-n", 6000, "--json", "--characteristics", "peak_force,max_deflection"))
+    exact = json.loads(cli.ok(*POP, "-n", 6000, "--json", "--characteristics", "peak_force,max_deflection"))
     method = report["percentile_method"]
     assert method["exact"] is False and 800 < method["sample_rows"] < 1200
     assert "estimate" in method["note"] and str(method["sample_rows"]) in method["note"]
@@ -250,8 +233,8 @@ def test_population_percentiles_estimated_from_sample_above_sample_size(capsys):
     assert set(report["statistics"]) == {"peak_force", "max_deflection"}
 
 
-def test_population_text_report_and_histograms(tmp_path, capsys):
-    out = ok(capsys, *POP, "-n", 3000, "--threshold", "peak_force>60N", "--hist", tmp_path / "h.png",
+def test_population_text_report_and_histograms(tmp_path, cli):
+    out = cli.ok(*POP, "-n", 3000, "--threshold", "peak_force>60N", "--hist", tmp_path / "h.png",
              "--characteristics", "peak_force,firmness_c")
     assert "population: 3000 rows" in out and "percentiles: exact" in out
     assert "peak_force>60N" in out and "firmness C = F_max/t_c" in out and "N/ms" in out
@@ -275,22 +258,22 @@ class Interrupt:
         return self.real(*args, **kwargs)
 
 
-def test_interrupted_population_resumes_to_identical_output(tmp_path, capsys, monkeypatch):
-    full, _ = population(tmp_path, capsys, "full.parquet", rows=7000, chunk=1000)
+def test_interrupted_population_resumes_to_identical_output(tmp_path, monkeypatch, cli):
+    full, _ = population(tmp_path, cli, "full.parquet", rows=7000, chunk=1000)
     out = tmp_path / "resumed.parquet"
     argv = (*POP, "-n", 7000, "--chunk-size", 1000, "-o", out, "--json")
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(3))
-    status, _, err = cli(capsys, *argv)
+    status, _, err = cli.run(*argv)
     assert status == 130 and "interrupted" in err and "resume" in err
     parts = tmp_path / "resumed.parquet.parts"
     assert len(list(parts.glob("part-*.arrow"))) == 3 and not out.exists()
     stale = parts / ".part-0000009.arrow.fruitimpact-tmp-1-deadbeef"
     stale.write_bytes(b"half a chunk")  # killed while writing
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(2))
-    assert cli(capsys, *argv)[0] == 130
+    assert cli.run(*argv)[0] == 130
     assert len(list(parts.glob("part-*.arrow"))) == 5 and not stale.exists()
     monkeypatch.undo()
-    report = json.loads(ok(capsys, *argv))
+    report = json.loads(cli.ok(*argv))
     assert report["resumed_chunks"] == 5
     resumed = read(out)
     assert len(resumed) == 7000 and resumed["row"].is_unique
@@ -298,33 +281,33 @@ def test_interrupted_population_resumes_to_identical_output(tmp_path, capsys, mo
     assert not parts.exists()
 
 
-def test_deleted_parts_are_recomputed(tmp_path, capsys, monkeypatch):
+def test_deleted_parts_are_recomputed(tmp_path, cli, monkeypatch):
     source = tmp_path / "in.csv"
     pd.DataFrame({"velocity": np.linspace(0.2, 2.0, 50), "mass": ["100g"] * 50}).to_csv(source, index=False)
-    ok(capsys, "batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
+    cli.ok("batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(6))
-    assert cli(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
+    assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     parts = tmp_path / "out.csv.parts"
     (parts / "part-0000002.arrow").unlink()
     (parts / "part-0000004.arrow").unlink()
-    out = ok(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
+    out = cli.ok("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
     assert "50 rows: 50 ok" in out and "4 chunks resumed" in out
     pd.testing.assert_frame_equal(read(tmp_path / "out.csv"), read(tmp_path / "full.csv"))
 
 
-def test_work_directory_of_another_job_is_refused(tmp_path, capsys, monkeypatch):
+def test_work_directory_of_another_job_is_refused(tmp_path, cli, monkeypatch):
     out = tmp_path / "pop.parquet"
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(1))
-    assert cli(capsys, *POP, "-n", 3000, "--chunk-size", 1000, "-o", out)[0] == 130
+    assert cli.run(*POP, "-n", 3000, "--chunk-size", 1000, "-o", out)[0] == 130
     monkeypatch.undo()
     for changed in (("--seed", 8), ("-n", 4000), ("--chunk-size", 500), ("--mass", "normal(116g,10g)")):
         argv = list(POP) + ["-n", 3000, "--chunk-size", 1000, "-o", out]
         argv[argv.index(changed[0]) + 1] = changed[1]
-        line = error_line(capsys, *argv)
+        line = cli.error(*argv)
         assert "pop.parquet.parts holds the parts of a different job" in line and "--fresh" in line
     assert not out.exists()
-    ok(capsys, *POP, "-n", 3000, "--chunk-size", 1000, "-o", out, "--seed", 9, "--fresh")
+    cli.ok(*POP, "-n", 3000, "--chunk-size", 1000, "-o", out, "--seed", 9, "--fresh")
     assert len(read(out)) == 3000
 
 
@@ -349,13 +332,13 @@ def test_work_directory_of_another_job_is_refused(tmp_path, capsys, monkeypatch)
     (["--model", "nope"], "argument --model: model must be one of"),
     (["--chunk-size", "1.5"], "argument --chunk-size: must be an integer in [1, 10,000,000]"),
 ])
-def test_population_bad_input_one_line(capsys, argv, message):
-    line = error_line(capsys, "population", *argv)
+def test_population_bad_input_one_line(cli, argv, message):
+    line = cli.error("population", *argv)
     assert line.startswith("fruitimpact population: error: " + message), line
 
 
-def test_population_invalid_members_are_counted_not_fatal(capsys):
-    report = json.loads(ok(capsys, "population", "-n", 2000, "--mass", "normal(50g,40g)", "--json",
+def test_population_invalid_members_are_counted_not_fatal(cli):
+    report = json.loads(cli.ok("population", "-n", 2000, "--mass", "normal(50g,40g)", "--json",
                            "--threshold", "peak_force>0"))
     assert report["invalid"] > 0 and report["ok"] + report["invalid"] + report["failed"] == 2000
     assert report["statistics"]["peak_force"]["count"] == report["ok"] == report["thresholds"][0]["count"]
@@ -368,17 +351,17 @@ def test_threshold_units_for_firmness():
     assert runs.Threshold.parse("max_deflection<2mm").value == pytest.approx(2e-3)
 
 
-def test_batch_of_an_empty_file_writes_the_columns(tmp_path, capsys):
+def test_batch_of_an_empty_file_writes_the_columns(tmp_path, cli):
     (tmp_path / "in.csv").write_text("mass,velocity\n")
-    assert "0 rows: 0 ok, 0 invalid, 0 failed" in ok(capsys, "batch", tmp_path / "in.csv", "-o", tmp_path / "o.parquet")
+    assert "0 rows: 0 ok, 0 invalid, 0 failed" in cli.ok("batch", tmp_path / "in.csv", "-o", tmp_path / "o.parquet")
     result = read(tmp_path / "o.parquet")
     assert len(result) == 0 and list(result.columns[:2]) == ["row", "mass"] and "peak_force" in result
 
 
-def test_population_with_every_input_at_its_default(capsys):
+def test_population_with_every_input_at_its_default(cli):
     # no distribution given: every member is the default apple, and the row count holds
     # even past the percentile sample size (regression: 0 rows / crash)
-    report = json.loads(ok(capsys, "population", "-n", 3000, "--chunk-size", 1000, "--sample-size", 500, "--json"))
+    report = json.loads(cli.ok("population", "-n", 3000, "--chunk-size", 1000, "--sample-size", 500, "--json"))
     assert report["rows"] == 3000 and report["ok"] == 3000
     default = simulate().characteristics.peak_force
     stats = report["statistics"]["peak_force"]

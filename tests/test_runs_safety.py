@@ -16,29 +16,7 @@ import pandas as pd
 import pytest
 
 from fruitimpact import runs
-from fruitimpact.cli import main
 from fruitimpact.quantities import DEFAULT_SUMMARY
-
-
-def cli(capsys, *argv):
-    status = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def ok(capsys, *argv) -> str:
-    status, out, err = cli(capsys, *argv)
-    assert status == 0, err
-    return out
-
-
-def error_line(capsys, *argv) -> str:
-    status, out, err = cli(capsys, *argv)
-    assert status == 2, (status, out, err)
-    assert "Traceback" not in err
-    lines = err.splitlines()
-    assert len(lines) == 1, err
-    return lines[0]
 
 
 class Interrupt:
@@ -68,46 +46,46 @@ def dead_pid() -> int:
 
 
 # --------------------------------------------------------------------------- B.1, B.2, B.5 ownership
-def test_fresh_never_deletes_a_folder_fruitimpact_did_not_make(tmp_path, capsys, monkeypatch):
+def test_fresh_never_deletes_a_folder_fruitimpact_did_not_make(tmp_path, cli, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "userdata").mkdir()
     (tmp_path / "userdata" / "notes.txt").write_text("x")
-    line = error_line(capsys, "population", "-n", 1000, "--workdir", "userdata", "--fresh")
+    line = cli.error("population", "-n", 1000, "--workdir", "userdata", "--fresh")
     assert "userdata" in line and "not fruitimpact's" in line
     assert (tmp_path / "userdata" / "notes.txt").read_text() == "x"
-    line = error_line(capsys, "population", "-n", 1000, "--workdir", ".", "--fresh")
+    line = cli.error("population", "-n", 1000, "--workdir", ".", "--fresh")
     assert "not fruitimpact's" in line and (tmp_path / "userdata" / "notes.txt").exists()
 
 
-def test_an_empty_folder_is_adopted_and_kept(tmp_path, capsys):
+def test_an_empty_folder_is_adopted_and_kept(tmp_path, cli):
     (tmp_path / "wd").mkdir()
-    ok(capsys, "population", "-n", 3000, "--chunk-size", 1000, "--workdir", tmp_path / "wd")
+    cli.ok("population", "-n", 3000, "--chunk-size", 1000, "--workdir", tmp_path / "wd")
     assert (tmp_path / "wd").is_dir() and list((tmp_path / "wd").iterdir()) == []
 
 
-def test_output_inside_the_work_folder_survives_cleanup(tmp_path, capsys):
+def test_output_inside_the_work_folder_survives_cleanup(tmp_path, cli):
     wd = tmp_path / "wd"
     wd.mkdir()
-    out = ok(capsys, "sweep", "--velocity", "0.5:1:3", "-o", wd / "out.csv", "--workdir", wd)
+    out = cli.ok("sweep", "--velocity", "0.5:1:3", "-o", wd / "out.csv", "--workdir", wd)
     assert "written to" in out
     assert len(pd.read_csv(wd / "out.csv")) == 3
     assert sorted(p.name for p in wd.iterdir()) == ["out.csv"]
     # the same command again: the folder holds only our output, and the run goes through
-    ok(capsys, "sweep", "--velocity", "0.5:1:3", "-o", wd / "out.csv", "--workdir", wd)
+    cli.ok("sweep", "--velocity", "0.5:1:3", "-o", wd / "out.csv", "--workdir", wd)
     assert sorted(p.name for p in wd.iterdir()) == ["out.csv"]
 
 
-def test_user_files_in_our_work_folder_are_kept(tmp_path, capsys, monkeypatch):
+def test_user_files_in_our_work_folder_are_kept(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(2))
-    assert cli(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
+    assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     (tmp_path / "out.csv.parts" / "mine.txt").write_text("keep me")
-    ok(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
+    cli.ok("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
     assert [p.name for p in (tmp_path / "out.csv.parts").iterdir()] == ["mine.txt"]
 
 
-def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, capsys, monkeypatch):
+def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, cli, monkeypatch):
     monkeypatch.chdir(tmp_path)
     plan = runs.Plan("population", runs.PopulationSource((), (), 100, 0), runs.CHUNK_ROWS, write_rows=False,
                      stats=DEFAULT_SUMMARY, sample_rows=runs.SAMPLE_ROWS)
@@ -116,19 +94,19 @@ def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, 
     for folder in (same_name, other):
         folder.mkdir()
         (folder / "data.bin").write_text("someone else's")
-    ok(capsys, "population", "-n", 100, "--seed", 1)  # another job: its own folder
-    line = error_line(capsys, "population", "-n", 100, "--fresh")  # our job's name, not our folder
+    cli.ok("population", "-n", 100, "--seed", 1)  # another job: its own folder
+    line = cli.error("population", "-n", 100, "--fresh")  # our job's name, not our folder
     assert "not fruitimpact's" in line
     assert (same_name / "data.bin").exists() and (other / "data.bin").exists()
 
 
 # --------------------------------------------------------------------------- B.3 verified parts
 @pytest.mark.parametrize("damage", ["replaced", "flipped", "truncated", "torn manifest"])
-def test_damaged_parts_are_recomputed(tmp_path, capsys, monkeypatch, damage):
+def test_damaged_parts_are_recomputed(tmp_path, cli, monkeypatch, damage):
     source = velocities_csv(tmp_path / "in.csv")
-    ok(capsys, "batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
+    cli.ok("batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(5))
-    assert cli(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
+    assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     parts = tmp_path / "out.csv.parts"
     part = parts / "part-0000002.arrow"
@@ -143,22 +121,22 @@ def test_damaged_parts_are_recomputed(tmp_path, capsys, monkeypatch, damage):
     else:
         with open(parts / "manifest.jsonl", "a") as handle:
             handle.write('{"chunk": 9, "start": ')  # a kill while appending
-    out = ok(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
+    out = cli.ok("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
     assert "50 rows: 50 ok" in out
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "out.csv"), pd.read_csv(tmp_path / "full.csv"))
 
 
-def test_manifest_records_row_ranges_and_hashes(tmp_path, capsys, monkeypatch):
+def test_manifest_records_row_ranges_and_hashes(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(3))
-    assert cli(capsys, "batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)[0] == 130
+    assert cli.run("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)[0] == 130
     lines = [json.loads(line) for line in (tmp_path / "out.parquet.parts" / "manifest.jsonl").read_text().splitlines()]
     assert "fingerprint" in lines[0]
     assert [(r["chunk"], r["start"], r["rows"]) for r in lines[1:]] == [(0, 0, 7), (1, 7, 7), (2, 14, 7)]
     assert all(len(r["part"]["sha256"]) == 64 and r["statuses"] == {"ok": 7} for r in lines[1:])
 
 
-def test_an_input_file_changed_during_the_run_is_refused(tmp_path, capsys, monkeypatch):
+def test_an_input_file_changed_during_the_run_is_refused(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
     real = runs.chunks.run_chunk
 
@@ -170,40 +148,40 @@ def test_an_input_file_changed_during_the_run_is_refused(tmp_path, capsys, monke
         return result
 
     monkeypatch.setattr(runs.chunks, "run_chunk", edit_after_first)
-    line = error_line(capsys, "batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
+    line = cli.error("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
     assert "changed during the run" in line and "--fresh" in line
     assert not (tmp_path / "out.csv").exists()
     assert not [p for p in tmp_path.iterdir() if "fruitimpact-tmp" in p.name]
 
 
 # --------------------------------------------------------------------------- B.4 locks, temporaries
-def test_a_second_run_on_the_same_output_or_work_folder_is_refused(tmp_path, capsys, monkeypatch):
+def test_a_second_run_on_the_same_output_or_work_folder_is_refused(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
     out = tmp_path / "out.csv"
     held = runs.locking.RunLock(runs.execute_module.output_lock_path(out), "output").acquire()
     try:
-        line = error_line(capsys, "batch", source, "-o", out, "--workdir", tmp_path / "elsewhere")
+        line = cli.error("batch", source, "-o", out, "--workdir", tmp_path / "elsewhere")
         assert "in use by another fruitimpact run" in line and f"pid {os.getpid()}" in line
     finally:
         held.release(remove=True)
     monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(1))
-    assert cli(capsys, "batch", source, "-o", out, "--chunk-size", 7)[0] == 130
+    assert cli.run("batch", source, "-o", out, "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     held = runs.locking.RunLock(tmp_path / "out.csv.parts" / ".fruitimpact-lock", "work folder").acquire()
     try:
-        line = error_line(capsys, "batch", source, "-o", tmp_path / "other.csv", "--workdir", tmp_path / "out.csv.parts")
+        line = cli.error("batch", source, "-o", tmp_path / "other.csv", "--workdir", tmp_path / "out.csv.parts")
         assert "in use by another fruitimpact run" in line and f"pid {os.getpid()}" in line
     finally:
         held.release()
-    ok(capsys, "batch", source, "-o", out, "--chunk-size", 7)
+    cli.ok("batch", source, "-o", out, "--chunk-size", 7)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.csv", "out.csv"]
 
 
-def test_stale_temporaries_of_the_output_are_removed(tmp_path, capsys):
+def test_stale_temporaries_of_the_output_are_removed(tmp_path, cli):
     out = tmp_path / "grid.parquet"
     stale = tmp_path / f".grid.parquet.fruitimpact-tmp-{dead_pid()}-0123abcd"
     stale.write_bytes(b"a merge killed half way")
-    ok(capsys, "sweep", "--velocity", "0.5:1:3", "-o", out)
+    cli.ok("sweep", "--velocity", "0.5:1:3", "-o", out)
     assert not stale.exists() and len(pd.read_parquet(out)) == 3
 
 
@@ -223,16 +201,16 @@ def test_stale_temporaries_of_the_output_are_removed(tmp_path, capsys):
     (["population", "--sample-size", "1e9"], "argument --sample-size: must be an integer in [1, 20,000,000]"),
     (["population", "--workers", "0", "--engine", "dask"], "argument --workers: must be an integer in [1, 256]"),
 ])
-def test_bad_outputs_and_limits_are_one_line_before_work(tmp_path, capsys, monkeypatch, argv, words):
+def test_bad_outputs_and_limits_are_one_line_before_work(tmp_path, cli, monkeypatch, argv, words):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "adir.csv").mkdir()
     (tmp_path / "afile").write_text("")
-    line = error_line(capsys, *argv)
+    line = cli.error(*argv)
     assert words in line, line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["adir.csv", "afile"]  # nothing was started
 
 
-def test_a_full_disk_is_one_line_and_keeps_the_work_done(tmp_path, capsys, monkeypatch):
+def test_a_full_disk_is_one_line_and_keeps_the_work_done(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
     real = runs.chunks.write_part
 
@@ -242,30 +220,30 @@ def test_a_full_disk_is_one_line_and_keeps_the_work_done(tmp_path, capsys, monke
         return real(workdir, index, table)
 
     monkeypatch.setattr(runs.chunks, "write_part", full_after_two)
-    line = error_line(capsys, "batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
+    line = cli.error("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
     assert "No space left on device" in line and "2 completed chunks are kept" in line
     assert not (tmp_path / "out.parquet").exists()
     monkeypatch.undo()
-    assert "2 chunks resumed" in ok(capsys, "batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
+    assert "2 chunks resumed" in cli.ok("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
     assert list(pd.read_parquet(tmp_path / "out.parquet")["row"]) == list(range(50))
 
 
-def test_a_long_run_announces_an_estimate(capsys, monkeypatch, tmp_path):
+def test_a_long_run_announces_an_estimate(cli, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(runs.execute_module, "ESTIMATE_AFTER", 0.0)
-    status, _, err = cli(capsys, "population", "-n", 3000, "--chunk-size", 1000)
+    status, _, err = cli.run("population", "-n", 3000, "--chunk-size", 1000)
     assert status == 0 and "extrapolated from the first chunk: 1,000 rows in" in err
 
 
 # --------------------------------------------------------------------------- D.17 seeds, counts
-def test_seeds_above_2_53_are_exact(capsys, tmp_path, monkeypatch):
+def test_seeds_above_2_53_are_exact(cli, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     common = ("population", "-n", 50, "--mass", "normal(115g,10g)", "--json", "--characteristics", "peak_force")
-    a = json.loads(ok(capsys, *common, "--seed", 9007199254740993))
-    b = json.loads(ok(capsys, *common, "--seed", 9007199254740992))
+    a = json.loads(cli.ok(*common, "--seed", 9007199254740993))
+    b = json.loads(cli.ok(*common, "--seed", 9007199254740992))
     assert a["seed"] == 9007199254740993 and b["seed"] == 9007199254740992
     assert a["statistics"]["peak_force"]["mean"] != b["statistics"]["peak_force"]["mean"]
-    assert json.loads(ok(capsys, "population", "-n", "1e3", "--json"))["rows"] == 1000
+    assert json.loads(cli.ok("population", "-n", "1e3", "--json"))["rows"] == 1000
 
 
 def test_status_line_counts_every_status():

@@ -81,14 +81,24 @@ class Evaluation:
         data = {name: value.to_pandas() if isinstance(value, Labels) else value for name, value in self._all().items()}
         return pd.DataFrame({name: data[name] for name in OUTPUT_COLUMNS}, copy=False)
 
-    def table(self):
-        """A pyarrow Table of ``OUTPUT_COLUMNS`` (text columns dictionary-encoded; floats not copied)."""
+    def table(self, first_row: int | None = None):
+        """A pyarrow Table of ``OUTPUT_COLUMNS`` (text columns dictionary-encoded; floats not
+        copied), with a ``row`` column in front numbering the rows from ``first_row`` if given."""
         import pyarrow as pa
 
         data = self._all()
         arrays = [data[name].to_arrow() if isinstance(data[name], Labels) else pa.array(data[name])
                   for name in OUTPUT_COLUMNS]
-        return pa.Table.from_arrays(arrays, names=list(OUTPUT_COLUMNS))
+        names = list(OUTPUT_COLUMNS)
+        if first_row is not None:
+            arrays.insert(0, pa.array(np.arange(first_row, first_row + self.rows, dtype=np.int64)))
+            names.insert(0, "row")
+        return pa.Table.from_arrays(arrays, names=names)
+
+    def status_counts(self) -> dict[str, int]:
+        """Rows per status name (only the statuses present)."""
+        counts = np.bincount(self.status.astype(np.int64), minlength=len(STATUS_NAMES))
+        return {name: int(count) for name, count in zip(STATUS_NAMES, counts) if count}
 
 
 def _check_ranges(inputs: InputColumns, messages: MessageBook, detail: bool) -> None:
@@ -246,10 +256,10 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
         law = DAMPING_LAWS[model]
         idx = np.flatnonzero(valid & (groups == key))
         arguments = (law_stiffness[idx], factor[idx], mass[idx], velocity[idx], radius[idx], step[idx], tabulated)
-        out[idx] = solver.batch(law, *arguments)
+        group = solver.batch(law, *arguments)
         reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
-        judge(out, idx, status, messages, solver=solver, velocity=velocity, mass=mass, step=step,
-              reference=reference)
+        judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference)
+        out[idx] = group
 
     with np.errstate(invalid="ignore", divide="ignore"):
         leaves_hertz = (status != INVALID) & (out[:, CONTACT_RADIUS] > HERTZ_RANGE * radius)
@@ -288,6 +298,22 @@ def _mask(index: np.ndarray, size: int) -> np.ndarray:
     return mask
 
 
+def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluation:
+    """``evaluate`` without the DataFrame: the ``Evaluation`` (arrays, codes), for callers that
+    write Arrow tables or summarise columns (``runs``).  Same parameters as ``evaluate``."""
+    rows = None
+    messages = None
+    if errors is not None:
+        errors = list(errors)
+        rows = len(errors)
+        messages = MessageBook(rows)
+        for i, text in enumerate(errors):
+            if text:
+                messages.set_row(i, str(text))
+    inputs, messages = read_columns(table, messages, rows)
+    return evaluate_inputs(inputs, messages, tabulated=tabulated)
+
+
 def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.DataFrame":  # noqa: F821
     """Characteristics of every row of ``table``.
 
@@ -314,17 +340,7 @@ def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.Da
         ``damping_factor``), the characteristics, and categorical ``status``
         (ok, inaccurate, failed, invalid), ``message`` and ``warnings``.
     """
-    rows = None
-    messages = None
-    if errors is not None:
-        errors = list(errors)
-        rows = len(errors)
-        messages = MessageBook(rows)
-        for i, text in enumerate(errors):
-            if text:
-                messages.set_row(i, str(text))
-    inputs, messages = read_columns(table, messages, rows)
-    return evaluate_inputs(inputs, messages, tabulated=tabulated).frame()
+    return evaluation(table, tabulated=tabulated, errors=errors).frame()
 
 
 def curves(table, times=None, points: int = 201):
@@ -356,4 +372,4 @@ def curves(table, times=None, points: int = 201):
 
 
 __all__ = ["Evaluation", "HERTZ_RANGE", "INPUT_COLUMNS", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES", "TEXT_COLUMNS",
-           "curves", "evaluate", "evaluate_inputs"]
+           "curves", "evaluate", "evaluate_inputs", "evaluation"]

@@ -7,7 +7,7 @@ STANDARD_GRAVITY = 9.80665
 
 #: The paper's Jonathan apple (section 3, worked example): M = 115 g,
 #: d = 65 mm, E = 3 MPa, ν = 0.37, k = 0.577 at V_i = 1 m/s.
-#: Source: shared/reference/apple-impact-paper.txt, section 3 and eqs 26–27.
+#: Source: the founding paper, "Theoretical aspects about simulating the reaction to impact of apples on rigid plane surfaces", section 3 and eqs 26–27.
 JONATHAN_APPLE = dict(mass=0.115, diameter=0.065, modulus=3.0e6, poisson=0.37)
 JONATHAN_RESTITUTION = 0.577
 JONATHAN_VELOCITY = 1.0

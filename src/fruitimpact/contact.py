@@ -10,7 +10,7 @@ paper's eq 9, k_c = 0.943 E/(1-ν²) sqrt(d), whose 0.943 is (4/3)/sqrt(2).
 
 Sources: H. Hertz, J. reine angew. Math. 92 (1882) 156–171; K. L. Johnson,
 *Contact Mechanics*, Cambridge University Press (1985), §4.2 (eqs 4.22–4.24);
-the apple paper (shared/reference/apple-impact-paper.txt), eqs 7–9.
+the founding paper, "Theoretical aspects about simulating the reaction to impact of apples on rigid plane surfaces", eqs 7–9.
 """
 
 from __future__ import annotations

@@ -49,29 +49,35 @@ def _suggest_step(step, error, tolerance):
     return float(f"{step * factor:.1g}")
 
 
-def judge(out: np.ndarray, rows: np.ndarray, status: np.ndarray, messages: MessageBook, *, solver,
-          velocity: np.ndarray, mass: np.ndarray, step: np.ndarray, reference: np.ndarray | None = None) -> None:
-    """Judge computed ``rows`` of ``out`` (characteristics, modified in place: a round-off
-    excess of e over 1 is removed), setting ``status`` and ``messages`` of those rows.
+def judge(values: np.ndarray, rows: np.ndarray, status: np.ndarray, messages: MessageBook, *, solver,
+          velocity: np.ndarray, step: np.ndarray, reference: np.ndarray | None = None) -> None:
+    """Judge the characteristics ``values`` (one row per entry of ``rows``, modified in place:
+    a round-off excess of e over 1 is removed), setting ``status`` and ``messages`` of ``rows``.
 
-    ``reference`` holds the accurate solver's characteristics of the same rows when the
-    solver is ``checked``."""
-    values = out[rows]
+    ``velocity`` and ``step`` are per row of the whole table; ``reference`` holds the accurate
+    solver's characteristics of the same rows when the solver is ``checked``."""
     tolerance = solver.tolerance
-    finite = np.all(np.isfinite(values[:, list(ESSENTIAL)]), axis=1)
+    finite = np.ones(rows.size, dtype=bool)
+    for column in ESSENTIAL:
+        finite &= np.isfinite(values[:, column])
     e = values[:, RESTITUTION]
     with np.errstate(invalid="ignore"):
         collapsed = finite & ~((values[:, CONTACT_DURATION] > 0) & (values[:, MAX_DEFLECTION] > 0))
-        energy_created = finite & ~collapsed & (e > 1.0 + tolerance)
-        no_rebound = finite & ~collapsed & ~(e > 0.0)
-        roundoff = finite & ~collapsed & (e > 1.0) & ~energy_created
+        physical = finite & ~collapsed
+        energy_created = physical & (e > 1.0 + tolerance)
+        no_rebound = physical & ~(e > 0.0)
+        roundoff = physical & (e > 1.0) & ~energy_created
     if roundoff.any():  # exactly elastic: report e = 1 and no absorbed energy
-        index = rows[roundoff]
-        out[index, RESTITUTION] = 1.0
-        out[index, EXIT_VELOCITY] = velocity[index]
-        out[index, ABSORBED_ENERGY] = 0.0
+        values[roundoff, RESTITUTION] = 1.0
+        values[roundoff, EXIT_VELOCITY] = velocity[rows[roundoff]]
+        values[roundoff, ABSORBED_ENERGY] = 0.0
 
     failed = ~finite | collapsed | energy_created | no_rebound
+    status[rows] = OK
+    if not failed.any():
+        if solver.checked and reference is not None and rows.size:
+            _check_against_reference(values, rows, reference, status, messages, solver, step)
+        return
     status[rows[failed]] = FAILED
     if solver.checked and reference is not None:
         # the reference tells a method error (a step too coarse) from an impossible impact
@@ -79,13 +85,12 @@ def judge(out: np.ndarray, rows: np.ndarray, status: np.ndarray, messages: Messa
             messages.set_row(rows[i], _checked_failure(solver, values[i], reference[i], step[rows[i]]))
     messages.set(_mask(rows[~finite], status.size), "the solver did not reach separation (non-finite characteristics)")
     messages.set(_mask(rows[collapsed], status.size), UNDERFLOW_MESSAGE)
-    for index in rows[energy_created | no_rebound]:
-        what = "the solver created energy" if out[index, RESTITUTION] > 1.0 else "the fruit does not rebound"
-        messages.set_row(index, f"restitution {out[index, RESTITUTION]:.4g} is outside (0, 1]: {what}")
-    done = rows[~failed]
-    status[done] = OK
-    if solver.checked and reference is not None and done.size:
-        _check_against_reference(out, done, reference[~failed], status, messages, solver, step)
+    for i in np.flatnonzero(energy_created | no_rebound):
+        what = "the solver created energy" if values[i, RESTITUTION] > 1.0 else "the fruit does not rebound"
+        messages.set_row(rows[i], f"restitution {values[i, RESTITUTION]:.4g} is outside (0, 1]: {what}")
+    if solver.checked and reference is not None:
+        kept = ~failed
+        _check_against_reference(values[kept], rows[kept], reference[kept], status, messages, solver, step)
 
 
 def _mask(index: np.ndarray, size: int) -> np.ndarray:
@@ -109,9 +114,8 @@ def _checked_failure(solver, values, reference_row, step) -> str:
             f"{_suggest_step(step, 1.0, solver.tolerance):g} s")
 
 
-def _check_against_reference(out, rows, reference, status, messages, solver, step):
+def _check_against_reference(values, rows, reference, status, messages, solver, step):
     """Mark rows whose error against the accurate solver exceeds the solver's tolerance."""
-    values = out[rows]
     errors = np.zeros((rows.size, len(CHECKED)))
     with np.errstate(divide="ignore", invalid="ignore"):
         for j, (_, column, relative) in enumerate(CHECKED):

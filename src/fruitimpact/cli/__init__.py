@@ -1,24 +1,26 @@
 """Command-line interface: ``fruitimpact simulate | paper | models | batch | sweep | population``.
 
 One module per group of commands (``simulate``, ``reference``, ``runs``); the
-shared option handling and the one-line error live in ``common``.  Heavy
-imports (matplotlib, pandas, scipy, pyarrow, dask) happen only in the
+shared option handling and the one-line error live in ``common``.  This
+module imports nothing but the standard library, so that a Ctrl-C at any
+moment of the start-up is answered with one line (exit status 130), and
+heavy imports (numba, pandas, matplotlib, pyarrow, dask) happen only in the
 subcommands that need them.
 """
 
 from __future__ import annotations
 
-import argparse
+import importlib
 import sys
 
-from .common import PROG, UsageError, _attach_negative_values, _numba_without_blas, _Parser, dump_json
-from .simulate import format_result_table
-
-__all__ = ["PROG", "UsageError", "build_parser", "dump_json", "format_result_table", "main"]
+PROG = "fruitimpact"
+COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser():
+    """The argparse parser of every command (built from the table of quantities)."""
     from . import reference, runs, simulate
+    from .common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -28,25 +30,52 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _command(argv) -> str | None:
+    return next((token for token in argv if token in COMMANDS), None)
+
+
 def main(argv=None) -> int:
-    if argv is None:  # the console script; in-process callers keep numba's defaults
-        _numba_without_blas()
-    parser = build_parser()
-    argv = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
+    """Run ``fruitimpact ARGV``; returns the exit status (0 ok, 1 a result not ok, 2 bad input,
+    130 interrupted)."""
+    console = argv is None  # the console script; in-process callers keep numba's defaults
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        args = parser.parse_args(argv)
-        if getattr(args, "func", None) is None:
-            parser.print_help()
+        from .common import UsageError, _attach_negative_values, _numba_without_blas
+
+        if console:
+            _numba_without_blas()
+        parser = build_parser()
+        argv = _attach_negative_values(argv)
+        try:
+            args = parser.parse_args(argv)
+            if getattr(args, "func", None) is None:
+                parser.print_help()
+                return 2
+            return args.func(args)
+        except UsageError as exc:
+            command = getattr(locals().get("args"), "command", None) or _command(argv)
+            prefix = f"{PROG} {command}" if command else PROG
+            print(f"{prefix}: error: {exc}", file=sys.stderr)
             return 2
-        return args.func(args)
-    except UsageError as exc:
-        command = getattr(locals().get("args"), "command", None) or next(
-            (token for token in argv if token in ("simulate", "paper", "models", "batch", "sweep", "population")), None)
-        prefix = f"{PROG} {command}" if command else PROG
-        print(f"{prefix}: error: {exc}", file=sys.stderr)
-        return 2
+    except KeyboardInterrupt:
+        command = _command(argv)
+        print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
+        return 130
     except BrokenPipeError:  # e.g. piped into head
         return 0
+
+
+_EXPORTS = {"UsageError": "common", "dump_json": "common", "format_result_table": "simulate"}
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'fruitimpact.cli' has no attribute {name!r}")
+    return getattr(importlib.import_module(f".{module}", __name__), name)
+
+
+__all__ = ["COMMANDS", "PROG", "UsageError", "build_parser", "dump_json", "format_result_table", "main"]
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,7 +17,7 @@ from ..quantities import INPUTS, option_of
 from ..units import parse_quantity
 from ..validation import conflict_message
 
-PROG = "fruitimpact"
+from . import PROG  # noqa: E402  (the package defines it before importing this module)
 
 
 class UsageError(Exception):

@@ -17,46 +17,14 @@ from .workdir import write_part, write_summary
 
 
 def evaluate_rows(inputs, start: int, errors=None):
-    """``batch.evaluate`` of ``inputs`` with a ``row`` column (row numbers from ``start``) in front.
+    """``batch.evaluation`` of ``inputs`` (an ``Evaluation``: arrays and codes, no DataFrame).
 
     ``errors``: None, or a message per row that makes the row invalid unread (ragged CSV rows).
     Power-law rows always use the engine's table, so results do not depend on where
-    the chunk boundaries fall."""
-    from ..batch import evaluate
+    the chunk boundaries fall; ``start`` numbers the rows (``Evaluation.table(start)``)."""
+    from ..batch import evaluation
 
-    options = {"errors": errors} if errors is not None else {}
-    result = evaluate(inputs, tabulated=True, **options)
-    result.insert(0, "row", np.arange(start, start + len(result), dtype=np.int64))
-    return result
-
-
-def arrow_table(frame):
-    """The chunk as an Arrow table whose schema depends only on the columns' kinds
-    (int64, float64, bool, string), so that every chunk of a run has the same schema."""
-    import pyarrow as pa
-
-    arrays = []
-    for name in frame.columns:
-        column = frame[name]
-        kind = getattr(column.dtype, "kind", "O")
-        if kind in "iu":
-            arrays.append(pa.array(column.to_numpy(), type=pa.int64()))
-        elif kind == "f":
-            arrays.append(pa.array(column.to_numpy(), type=pa.float64()))
-        elif kind == "b":
-            arrays.append(pa.array(column.to_numpy(), type=pa.bool_()))
-        else:  # text: categorical, pandas strings or objects
-            array = pa.array(column, from_pandas=True)
-            if pa.types.is_dictionary(array.type):
-                array = array.dictionary_decode()
-            arrays.append(array.cast(pa.string()))
-    return pa.Table.from_arrays(arrays, names=[str(name) for name in frame.columns])
-
-
-def status_counts(frame) -> dict[str, int]:
-    """Rows per status (whatever statuses ``evaluate`` reports)."""
-    counts = frame["status"].astype(str).value_counts(sort=False)
-    return {str(status): int(count) for status, count in counts.items() if count}
+    return evaluation(inputs, tabulated=True, errors=errors)
 
 
 def _moments(values: np.ndarray) -> tuple:
@@ -66,21 +34,22 @@ def _moments(values: np.ndarray) -> tuple:
     return values.size, mean, float(np.sum((values - mean) ** 2)), float(values.min()), float(values.max())
 
 
-def summarise(plan, frame, start: int) -> dict | None:
+def summarise(plan, result, start: int) -> dict | None:
     """The summary arrays of a chunk of a population (None without statistics): moments
     (n, mean, M2, min, max) and threshold counts of the ok rows, and the rows kept in
     the percentile sample (every ok row, or those whose seeded key is below the sample
     probability)."""
     if not plan.stats:
         return None
-    ok = (frame["status"] == "ok").to_numpy(dtype=bool)
-    data = {name: frame[name].to_numpy(dtype=float) for name in set(plan.stats) | {t.name for t in plan.thresholds}}
+    ok = result.status == 0
+    data = {name: np.asarray(result.columns[name], dtype=float)
+            for name in set(plan.stats) | {t.name for t in plan.thresholds}}
     moments = []
     for name in plan.stats:
         values = data[name][ok]
         moments.append(_moments(values[np.isfinite(values)]))
     probability = plan.sample_probability
-    chosen = ok if probability >= 1.0 else ok & (plan.source.keys(start, start + len(frame)) < probability)
+    chosen = ok if probability >= 1.0 else ok & (plan.source.keys(start, start + result.rows) < probability)
     sample = np.empty((int(chosen.sum()), len(plan.stats)))
     for j, name in enumerate(plan.stats):
         sample[:, j] = data[name][chosen]
@@ -118,13 +87,13 @@ def run_chunk(plan, index: int, payload, workdir: str, numba_threads: int | None
     start = index * plan.chunk_rows
     stop = start + plan.chunk_rows if plan.rows is None else min(start + plan.chunk_rows, plan.rows)
     inputs, errors = plan.source.inputs(start, stop, payload)
-    frame = evaluate_rows(inputs, start, errors)
-    summary = summarise(plan, frame, start)
-    record = {"chunk": index, "start": start, "rows": len(frame), "statuses": status_counts(frame),
+    result = evaluate_rows(inputs, start, errors)
+    summary = summarise(plan, result, start)
+    record = {"chunk": index, "start": start, "rows": result.rows, "statuses": result.status_counts(),
               "part": None, "summary": None}
     table = None
     if plan.write_rows:
-        table = arrow_table(frame)
+        table = result.table(start)
         record["part"] = write_part(workdir, index, table)
     if summary is not None:
         record["summary"] = write_summary(workdir, index, summary)
