@@ -146,6 +146,83 @@ def max_rel_error(values, reference):
     return float(np.max(np.abs(values / reference - 1.0)))
 
 
+def fruit_columns(rows, seed=1):
+    """A population as ``batch.evaluate`` takes it: mass, modulus, velocity and restitution [SI]."""
+    rng = np.random.default_rng(seed)
+    return {"mass": rng.normal(0.115, 0.01, rows), "modulus": 3e6 * np.exp(rng.normal(0.0, 0.2, rows)),
+            "velocity": rng.uniform(0.5, 1.5, rows), "restitution": rng.uniform(0.3, 0.8, rows)}
+
+
+def numpy_floor(columns):
+    """The floor of ``batch.evaluate``: a plain NumPy evaluation, on the same arrays, of only the
+    contact stiffness (eq 9), the restitution of the paper's Hunt–Crossley damping (Newton on the
+    exact relation (1 + x) = (1 - e x) exp((1 + e) x), 8 steps) and δ_max in closed form."""
+    m, E, v, e0 = columns["mass"], columns["modulus"], columns["velocity"], columns["restitution"]
+    k = 4.0 / 3.0 * E / (1.0 - 0.37 ** 2) * np.sqrt(0.0325)
+    x = 1.5 * (1.0 - e0)  # the paper's calibration, c V = 1.5 (1 - e) (eqs 5-6)
+    e = e0.copy()
+    for _ in range(8):
+        grow = np.exp((1.0 + e) * x)
+        g = (1.0 - e * x) * grow - (1.0 + x)
+        e = e - g / (x * grow * (1.0 - e * x - 1.0))
+    r = (x - np.log1p(x)) / x ** 2
+    return e, (2.5 * m * v ** 2 * r / k) ** 0.4
+
+
+def end_to_end(record, quick):
+    """The commands and calls users run, each against its floor in the same run (issue 6, section 5)."""
+    from fruitimpact.batch import evaluate
+    from fruitimpact.calibrate import damping_factor
+    from fruitimpact.engine.adaptive import adaptive_characteristics
+    from fruitimpact.calibrate import law_params
+    from fruitimpact.models import DAMPING_LAWS
+
+    n_eval = 200_000 if quick else 2_000_000
+    columns = fruit_columns(n_eval)
+    evaluate({k: a[:5000] for k, a in columns.items()}, tabulated=True)
+    evaluate({k: a[:50000] for k, a in columns.items()}, tabulated=True)
+    floor = best_of(lambda: numpy_floor(columns), 3)
+    ours = best_of(lambda: evaluate(columns, tabulated=True), 3)
+    record(f"batch.evaluate, {n_eval:,} rows (all characteristics, status)", ours,
+           "NumPy: k_c, e and δ_max only", floor, "s", "target: within 3×", of_baseline=True)
+
+    simulate(model="tsuji-clamped")
+    n = 500 if quick else 3000
+    hunt = best_of(lambda: [simulate() for _ in range(n)], 3) / n * 1e6
+    tsuji = best_of(lambda: [simulate(model="tsuji-clamped") for _ in range(n)], 3) / n * 1e6
+    record("one simulate(), tsuji-clamped, exact calibration", tsuji, "one hunt-crossley simulate()", hunt,
+           "µs/impact", "target: within 3×", of_baseline=True)
+
+    n_cal = 20_000 if quick else 200_000
+    rng = np.random.default_rng(3)
+    m, k, v = rng.uniform(0.08, 0.3, n_cal), rng.uniform(4e5, 2e6, n_cal), rng.uniform(0.3, 3.0, n_cal)
+    e = rng.uniform(0.05, 0.95, n_cal)
+    for name in ("tsuji-clamped", "kelvin-voigt-clamped", "kuwabara-kono"):
+        law = DAMPING_LAWS[name]
+
+        def run(calibration):
+            factor = damping_factor(law, calibration, e, m, k, v)
+            k_law = law.linear_stiffness(m, k, v)
+            return adaptive_characteristics(np.full(n_cal, law.family), law_params(law.family, k_law, factor),
+                                            np.full(n_cal, law.clamp), m, v, np.full(n_cal, 0.03))
+
+        run("exact")
+        exact = best_of(lambda: run("exact"), 3)
+        paper = best_of(lambda: run("paper"), 3)
+        record(f"{name}: exact calibration + engine, {n_cal:,} rows", n_cal / exact,
+               "published calibration + engine", n_cal / paper, "rows/s", "target: no slower than the engine")
+
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from runs import main as runs_main
+
+    lines = runs_main(["--rows", "200000" if quick else "1000000", "--population", "400000" if quick else "2000000",
+                       "--repeats", "1" if quick else "2"])
+    for task, value, baseline, base in lines:
+        target = "target: within 2×" if task.startswith("batch") and "subprocess" in task else \
+            "target: within 1.5×" if task.startswith("population") else ""
+        record(task, value, baseline, base, "s", target, of_baseline=True)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller sizes (for a smoke run)")
@@ -153,9 +230,11 @@ def main(argv=None):
     args = parser.parse_args(argv)
     rows = []
 
-    def record(task, fruitimpact_value, baseline_name, baseline_value, unit, note, compare=True):
+    def record(task, fruitimpact_value, baseline_name, baseline_value, unit, note, compare=True, of_baseline=False):
         if not compare:  # a reference point, not a competitor
             ratio = "–"
+        elif of_baseline:  # a time as a multiple of its floor (lower is better; the targets are "within N×")
+            ratio = f"{fruitimpact_value / baseline_value:.2f}× the baseline"
         elif unit.startswith("µs"):
             ratio = f"{baseline_value / fruitimpact_value:,.0f}×"
         else:
@@ -235,6 +314,9 @@ def main(argv=None):
         err = float(np.max(np.abs(got[finite] / tight[finite] - 1.0)))
         record(f"{name} batch, {n_other:,} impacts (2 cores)", n_other / elapsed, "loop of solve_ivp 1e-10",
                base_rate, "impacts/s", f"max rel. err vs DOP853 1e-12: {err:.1e}")
+
+    # ------------------------------------------------------------------ end to end (issue 6, section 5)
+    end_to_end(record, args.quick)
 
     # ------------------------------------------------------------------ CLI
     exe = shutil.which("fruitimpact")

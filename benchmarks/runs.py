@@ -107,7 +107,8 @@ def population(rows: int, repeats: int, folder: Path) -> list[tuple]:
     return [(f"population -n {rows:,}, summary only, in-process", run, "batch.evaluate, same members", evaluation)]
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> list:
+    """Run the benchmarks, print them, and return (task, seconds, baseline, baseline seconds) lines."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rows", type=int, default=1_000_000, help="rows of the batch CSV (default 1e6)")
     parser.add_argument("--population", type=int, default=2_000_000, help="members (default 2e6)")
@@ -120,6 +121,7 @@ def main(argv=None) -> None:
         lines = batch(args.rows, args.repeats, Path(tmp)) + population(args.population, args.repeats, Path(tmp))
     for task, value, baseline, base in lines:
         print(f"{task:<58} {value:8.2f} s | {baseline:<30} {base:8.2f} s  ratio {value / base:5.2f}×", flush=True)
+    return lines
 
 
 if __name__ == "__main__":

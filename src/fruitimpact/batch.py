@@ -22,13 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import contact
+from .calibrate import TABLE_E_MIN
 from .calibrate import damping_factor as calibrated_damping_factor
 from .constants import STANDARD_GRAVITY
 from .engine.powerlaw import CHARACTERISTIC_COLUMNS, CONTACT_RADIUS, N_CHARACTERISTICS
 from .inputs import InputColumns, read_columns
 from .models import DAMPING_LAWS
 from .registries import REGISTRIES
-from .quantities import ALTERNATIVES, GROUP_DEFAULTS, INPUTS, NUMERIC_INPUTS, TEXT_INPUTS
+from .quantities import (ALLOWED_BOUNDS, ALTERNATIVES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS, NUMERIC_INPUTS,
+                         PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
 from .solvers import SOLVERS, max_rk4_step, power_law_closed_forms
 from .status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from .labels import Labels
@@ -108,18 +110,15 @@ def _check_ranges(inputs: InputColumns, messages: MessageBook, detail: bool) -> 
             if isinstance(name, str) and name in inputs.values and np.isnan(inputs.values[name][i]) \
                     and messages.text(i) == nan_message(INPUTS[name]):
                 messages.codes[i] = messages.code(f"{nan_message(INPUTS[name])}; got nan", name)
-    for name in NUMERIC_INPUTS:
-        quantity = INPUTS[name]
-        if not inputs.given[name].any():
-            continue
-        bad = inputs.given[name] & ~messages.flagged & ~quantity.allowed.contains(inputs.values[name])
-        if bad.any():
-            text = range_message(quantity)
-            if detail:
-                text += f"; got {float(inputs.values[name][0])!r}"
-            messages.set(bad, text, name)
+    bad = inputs.given_matrix & ~inside(ALLOWED_BOUNDS, inputs.matrix)
+    for j in np.flatnonzero(bad.any(axis=1)):  # in table order: a row is refused for its first problem
+        name = NUMERIC_INPUTS[j]
+        text = range_message(INPUTS[name])
+        if detail:
+            text += f"; got {float(inputs.matrix[j, 0])!r}"
+        messages.set(bad[j] & ~messages.flagged, text, name)
     for group in ALTERNATIVES:
-        count = sum(inputs.given[name].astype(np.int8) for name in group)
+        count = np.sum([inputs.given[name] for name in group], axis=0)
         if np.any(count > 1):
             for i in np.flatnonzero(count > 1):
                 named = [name for name in group if inputs.given[name][i]]
@@ -136,14 +135,10 @@ def _check_text(inputs: InputColumns, messages: MessageBook) -> None:
 
 
 def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> None:
-    for name in NUMERIC_INPUTS:
-        quantity = INPUTS[name]
-        if quantity.plausible is None or not inputs.given[name].any():
-            continue
-        outside = inputs.given[name] & np.isfinite(inputs.values[name]) & \
-            ~quantity.plausible.contains(inputs.values[name])
-        if outside.any():
-            warnings.add(outside, implausible_message(quantity, inputs.values[name][0] if detail else None))
+    outside = inputs.given_matrix & np.isfinite(inputs.matrix) & ~inside(PLAUSIBLE_BOUNDS, inputs.matrix)
+    for j in np.flatnonzero(outside.any(axis=1)):
+        quantity = INPUTS[NUMERIC_INPUTS[j]]
+        warnings.add(outside[j], implausible_message(quantity, inputs.matrix[j, 0] if detail else None))
 
 
 def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: bool | None = None,
@@ -161,8 +156,8 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
     _check_text(inputs, messages)
     _plausibility(inputs, warnings, detail)
 
-    used = {name: np.where(given[name], values[name], INPUTS[name].default if INPUTS[name].default is not None
-                           else np.nan) for name in NUMERIC_INPUTS}
+    used_matrix = np.where(inputs.given_matrix, inputs.matrix, NUMERIC_DEFAULTS)
+    used = dict(zip(NUMERIC_INPUTS, used_matrix))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
         velocity = np.where(given["velocity"], values["velocity"],
                             np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
@@ -220,10 +215,11 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
                 with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
                     factor[rows_sub] = calibrated_damping_factor(law, calibration, target[rows_sub], mass[rows_sub],
                                                                  stiffness[rows_sub], velocity[rows_sub])
-                unreachable = rows_sub[~np.isfinite(factor[rows_sub]) & np.isfinite(law_stiffness[rows_sub])]
-                messages.set(_mask(unreachable, rows),
-                             f"model {model} cannot reach this restitution with calibration {calibration} "
-                             f"(see fruitimpact models for the range it reaches)", "restitution")
+                if calibration == "exact" and not family.first_integral and not law.exact_by_construction:
+                    below = rows_sub[target[rows_sub] < TABLE_E_MIN]
+                    messages.set(_mask(below, rows), f"restitution must be >= {TABLE_E_MIN:g} for model {model} with "
+                                                     f"calibration exact (its table of e against the damping stops "
+                                                     f"there)", "restitution")
 
     step = used["step"]
     rk4 = np.zeros(rows, dtype=bool)

@@ -62,23 +62,24 @@ def check_columns(names) -> dict[str, object]:
 @dataclass
 class InputColumns:
     """Inputs of ``rows`` impacts: ``values[name]`` float64 [SI] (NaN where not given or
-    unreadable), ``given[name]`` bool, ``text[name]`` ``Labels`` (defaults filled in)."""
+    unreadable), ``given[name]`` bool, ``text[name]`` ``Labels`` (defaults filled in).
+
+    The numeric inputs are rows of one matrix, ``matrix`` (inputs × rows, in the order of
+    ``quantities.NUMERIC_INPUTS``) with ``given_matrix`` beside it: the range checks of
+    every input are then a few whole-matrix operations, whatever the number of rows."""
 
     rows: int
     values: dict
     given: dict
     text: dict
+    matrix: np.ndarray
+    given_matrix: np.ndarray
 
 
 def _as_columns(table) -> dict:
     """Name → column of any supported container (pyarrow Table, DataFrame, mapping)."""
-    try:
-        import pyarrow as pa
-
-        if isinstance(table, (pa.Table, pa.RecordBatch)):
-            return {name: table.column(name) for name in table.column_names}
-    except ImportError:  # pragma: no cover - pyarrow is a dependency
-        pass
+    if _is_arrow(table):
+        return {name: table.column(name) for name in table.column_names}
     if hasattr(table, "columns") and hasattr(table, "__getitem__") and not isinstance(table, dict):
         return {name: table[name] for name in table.columns}  # a DataFrame
     if not hasattr(table, "items"):
@@ -88,9 +89,16 @@ def _as_columns(table) -> dict:
 
 
 def _length(column) -> int | None:
+    if isinstance(column, (list, tuple)):
+        return len(column)
     if isinstance(column, (str, bytes)) or np.ndim(column) == 0 and not hasattr(column, "__len__"):
         return None
     return len(column)
+
+
+def _is_arrow(column) -> bool:
+    """A pyarrow array or chunked array (checked without importing pyarrow)."""
+    return type(column).__module__.startswith("pyarrow")
 
 
 def _blank(strings: np.ndarray) -> np.ndarray:
@@ -99,15 +107,10 @@ def _blank(strings: np.ndarray) -> np.ndarray:
 
 def _object_cells(column) -> tuple[np.ndarray, np.ndarray]:
     """(cells as an object array, not-given mask) of a column of any container."""
-    try:
-        import pyarrow as pa
-
-        if isinstance(column, (pa.Array, pa.ChunkedArray)):
-            missing = column.is_null().to_numpy(zero_copy_only=False)
-            cells = np.asarray(column.to_numpy(zero_copy_only=False), dtype=object)
-            return cells, np.asarray(missing, dtype=bool)
-    except ImportError:  # pragma: no cover
-        pass
+    if _is_arrow(column):
+        missing = column.is_null().to_numpy(zero_copy_only=False)
+        cells = np.asarray(column.to_numpy(zero_copy_only=False), dtype=object)
+        return cells, np.asarray(missing, dtype=bool)
     if hasattr(column, "dtype") and hasattr(column, "isna") and not isinstance(column, np.ndarray):
         import pandas as pd
 
@@ -128,20 +131,21 @@ def _is_pd_na(cell) -> bool:
 
 def _fast_float(column, rows: int):
     """(values, given) without looking at cells, for purely numeric columns; None otherwise."""
-    try:
+    if isinstance(column, list):
+        if all(type(c) is float or type(c) is int for c in column):
+            return np.asarray(column, dtype=float), np.ones(rows, dtype=bool)
+        return None
+    if _is_arrow(column):
         import pyarrow as pa
 
-        if isinstance(column, (pa.Array, pa.ChunkedArray)):
-            if pa.types.is_floating(column.type) or pa.types.is_integer(column.type):
-                given = ~np.asarray(column.is_null().to_numpy(zero_copy_only=False), dtype=bool) \
-                    if column.null_count else np.ones(rows, dtype=bool)
-                values = np.asarray(column.to_numpy(zero_copy_only=False), dtype=float)
-                return values, given
-            if pa.types.is_null(column.type):
-                return np.full(rows, np.nan), np.zeros(rows, dtype=bool)
-            return None
-    except ImportError:  # pragma: no cover
-        pass
+        if pa.types.is_floating(column.type) or pa.types.is_integer(column.type):
+            given = ~np.asarray(column.is_null().to_numpy(zero_copy_only=False), dtype=bool) \
+                if column.null_count else np.ones(rows, dtype=bool)
+            values = np.asarray(column.to_numpy(zero_copy_only=False), dtype=float)
+            return values, given
+        if pa.types.is_null(column.type):
+            return np.full(rows, np.nan), np.zeros(rows, dtype=bool)
+        return None
     dtype = getattr(column, "dtype", None)
     if isinstance(dtype, np.dtype) and dtype.kind in "fiu":
         return np.asarray(column, dtype=float), np.ones(rows, dtype=bool)
@@ -153,7 +157,7 @@ def _fast_float(column, rows: int):
             # pandas keeps NaN and NA apart in nullable columns: NaN cells are given
             values = np.where(missing, np.nan, values)
         return values, ~missing
-    if isinstance(column, (list, tuple)) and all(type(c) in (float, int) for c in column):
+    if isinstance(column, tuple) and all(type(c) is float or type(c) is int for c in column):
         return np.asarray(column, dtype=float), np.ones(rows, dtype=bool)
     return None
 
@@ -222,19 +226,18 @@ def _text(name: str, column, rows: int) -> Labels:
     against their registry later).  Strings are stripped; numbers stay numbers (and are refused)."""
     default = INPUTS[name].default
     labels = None
-    try:
+    if isinstance(column, list) and len(column) == 1:  # one impact (simulate)
+        labels = Labels(np.zeros(1, dtype=np.int32), (column[0],))
+    elif _is_arrow(column):
         import pyarrow as pa
         import pyarrow.compute as pc
 
-        if isinstance(column, (pa.Array, pa.ChunkedArray)) and (pa.types.is_string(column.type)
-                                                                or pa.types.is_large_string(column.type)):
+        if pa.types.is_string(column.type) or pa.types.is_large_string(column.type):
             array = column.combine_chunks() if isinstance(column, pa.ChunkedArray) else column
             encoded = pc.dictionary_encode(array)
             indices = encoded.indices.fill_null(len(encoded.dictionary))
             labels = Labels(np.asarray(indices.to_numpy(zero_copy_only=False), dtype=np.int32),
                             tuple(encoded.dictionary.to_pylist()) + (None,))
-    except ImportError:  # pragma: no cover
-        pass
     if labels is None:
         cells, _ = _object_cells(column)
         labels = factorize(cells)
@@ -283,16 +286,17 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     for key, length in lengths.items():
         if length is None:  # a scalar: the same on every row
             by_key[key] = [by_key[key]] * rows
+    matrix = np.full((len(NUMERIC_INPUTS), rows), np.nan)
+    given_matrix = np.zeros((len(NUMERIC_INPUTS), rows), dtype=bool)
     values, given, text = {}, {}, {}
-    for name in NUMERIC_INPUTS:
+    for j, name in enumerate(NUMERIC_INPUTS):
         if name in by_key:
-            values[name], given[name] = _numeric(name, by_key[name], rows, messages)
-        else:
-            values[name], given[name] = np.full(rows, np.nan), np.zeros(rows, dtype=bool)
+            matrix[j], given_matrix[j] = _numeric(name, by_key[name], rows, messages)
+        values[name], given[name] = matrix[j], given_matrix[j]
     for name in TEXT_INPUTS:
         text[name] = _text(name, by_key[name], rows) if name in by_key else \
             Labels.constant(INPUTS[name].default, rows)
-    return InputColumns(rows, values, given, text), messages
+    return InputColumns(rows, values, given, text, matrix, given_matrix), messages
 
 
 __all__ = ["InputColumns", "check_columns", "column_key", "read_columns", "unknown_columns_message"]

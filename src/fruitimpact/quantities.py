@@ -196,6 +196,30 @@ NUMERIC_INPUTS = tuple(name for name, q in INPUTS.items() if q.numeric)
 TEXT_INPUTS = tuple(name for name, q in INPUTS.items() if not q.numeric)
 
 
+def _bounds(ranges) -> tuple[np.ndarray, ...]:
+    """(low, high, low inclusive, high inclusive) columns of ranges (None: everything inside)."""
+    ranges = [r if r is not None else Range(-math.inf, math.inf, True, True) for r in ranges]
+    return tuple(np.array([getattr(r, field) for r in ranges])[:, None]
+                 for field in ("low", "high", "low_inclusive", "high_inclusive"))
+
+
+def inside(bounds, matrix: np.ndarray) -> np.ndarray:
+    """Mask of the entries of ``matrix`` (inputs × rows) inside each input's range of ``bounds``
+    (NaN is outside): every input checked in four whole-matrix operations."""
+    low, high, low_inclusive, high_inclusive = bounds
+    above = np.where(low_inclusive, matrix >= low, matrix > low)
+    below = np.where(high_inclusive, matrix <= high, matrix < high)
+    return above & below
+
+
+#: Bounds of the numeric inputs' allowed and plausible ranges, in ``NUMERIC_INPUTS`` order.
+ALLOWED_BOUNDS = _bounds(INPUTS[name].allowed for name in NUMERIC_INPUTS)
+PLAUSIBLE_BOUNDS = _bounds(INPUTS[name].plausible for name in NUMERIC_INPUTS)
+#: Defaults of the numeric inputs (NaN: none), a column for ``numpy.where``.
+NUMERIC_DEFAULTS = np.array([INPUTS[name].default if INPUTS[name].default is not None else math.nan
+                             for name in NUMERIC_INPUTS])[:, None]
+
+
 #: Outputs of one impact (the characteristics, then the contact law as used).
 OUTPUTS: dict[str, Quantity] = _table(
     Quantity("peak_force", "F_max", "peak force F_max", "force", "N", 1.0, "largest contact force"),
@@ -248,6 +272,6 @@ def option_of(name: str) -> str:
     return quantity.option if quantity is not None and quantity.option else "--" + name.replace("_", "-")
 
 
-__all__ = ["ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY", "GROUP_DEFAULTS",
-           "INPUTS", "NON_NEGATIVE", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
+__all__ = ["ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
+           "GROUP_DEFAULTS", "INPUTS", "NON_NEGATIVE", "NUMERIC_DEFAULTS", "PLAUSIBLE_BOUNDS", "inside", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
            "Range", "TEXT_INPUTS", "input_quantity", "option_of"]

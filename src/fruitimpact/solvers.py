@@ -43,13 +43,13 @@ def power_law_closed_forms(stiffness, damping_factor, mass, velocity, exponent: 
     δ_max = [(n+1) m (x - ln(1+x)) / (K c²)]^(1/(n+1)), x = c v0, and e the root
     of (1 + x) = (1 - e x) exp((1 + e) x) (Hunt & Crossley 1975; docs/physics.md).
     A self-check beside the solvers' numbers, independent of their quadrature."""
-    from .engine.powerlaw import exact_restitution, r_func
+    from .engine.powerlaw import exact_restitution, r_array
 
     stiffness, damping_factor, mass, velocity = (np.asarray(a, dtype=float) for a in
                                                  (stiffness, damping_factor, mass, velocity))
     x = damping_factor * velocity
     # (x - ln(1+x))/c² = v0² r(x), written through r to stay exact as c → 0
-    r = np.vectorize(r_func, otypes=[float])(x)
+    r = r_array(x).reshape(x.shape)
     n = exponent
     max_deflection = ((n + 1.0) * mass * velocity ** 2 * r / stiffness) ** (1.0 / (n + 1.0))
     return max_deflection, exact_restitution(x)

@@ -14,11 +14,15 @@ Dormand & Prince's explicit Runge–Kutta pair of order 8 with the 5th/3rd
 order error estimators and the 7th-order dense output (DOP853: Hairer,
 Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd ed.
 1993, §II.10; coefficients as in Hairer's ``dop853.f`` and SciPy's
-``solve_ivp``).  The local error is measured against the natural scales of
-the impact: rtol·δ_ref for δ (δ_ref the elastic part's undamped maximum
-deflection) and rtol·v0 for δ̇, so ``rtol`` is a relative accuracy of the
-characteristics.  Step-size control as in DOP853 (safety 0.9, factors
-0.2–10, no growth right after a rejection).
+``solve_ivp``).  The integration runs in units of the impact (``_scales``):
+lengths in δ_ref (the elastic part's undamped maximum deflection), times in
+t_ref = δ_ref/v0, masses in m.  So every impact with the same dimensionless
+damping is the same computation, nothing inside it under- or overflows, and
+the local error is measured against rtol·δ_ref for δ and rtol·v0 for δ̇:
+``rtol`` is a relative accuracy of the characteristics.  Step-size control as
+in DOP853 (safety 0.9, factors 0.2–10, no growth right after a rejection).
+An impact whose scales (δ_ref, t_ref, m v0/t_ref, m v0²) are not normal
+doubles, or whose characteristics are not once scaled back, is NaN.
 
 The laws with δ^0.5 or δ^0.25 factors (and δ^n) make the motion
 non-smooth in t at δ = 0: near first touch and separation δ(t) is a series
@@ -44,19 +48,23 @@ a bracketing (Illinois) root finder, never read off a grid:
 * separation: σ = 0 (the end of phase C), or, clamped, the unclamped force
   F = 0 while δ̇ < 0 if that comes first (located as the sign change of F
   divided by its lowest power of δ, ``_release``); the exit velocity is δ̇
-  there;
+  there, from a step of the integrator to that point (8th order, where the
+  interpolant is 7th: e is read to the integration's accuracy);
 * maximum deflection: δ̇(t) = 0;
 * peak force: dF/dt = ∂F/∂δ·δ̇ + ∂F/∂δ̇·δ̈ = 0 (analytic, with δ̈ = -F/m),
-  crossing from + to -; the force at first touch (b·v0 for Kelvin–Voigt)
-  is a candidate too;
+  crossing from + to -; the force at first touch (b·v0 for Kelvin–Voigt,
+  the peak where dF/dt(0) = v0 k (1 - 4ζ²) ≤ 0) is a candidate too;
 * peak Hertz pressure 3F/(2πRδ): d(F/δ)/dt = 0, crossing from + to -, and
   the limits of F/δ at the ends of the contact.  Where a dissipative term
   vanishes more slowly than δ at first touch (Kelvin–Voigt b > 0,
   Kuwabara–Kono B > 0, Tsuji η > 0, power law n < 1) F/δ is unbounded and
   the maximum pressure is +inf.
 
-Both event functions are evaluated as δ·dF/dt and δ²·d(F/δ)/dt, which are
-finite at δ = 0 for every family.
+Both event functions are dF/dt and d(F/δ)/dt times the lowest power of δ
+that keeps them finite at δ = 0 (``_rates``): there they are the rates'
+leading terms, not 0, so an extremum inside the very first step (Kelvin–Voigt
+with ζ just below 1/2 peaks at t ≈ 1e-6 of the contact) is bracketed from the
+step's start and found to its own size.
 
 Conventions follow ``engine.rk4``/``engine.powerlaw``: firmness_c is
 F_max/t_peak and firmness_c_star F_max/t_peak² (NaN when the peak force is
@@ -70,8 +78,10 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, contact_force
-from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
+from .codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, KELVIN_VOIGT, KUWABARA_KONO, MAX_PRESSURE,
+                    N_CHARACTERISTICS, POWER_LAW, TIME_TO_PEAK)
+from .forces import contact_force
+from .powerlaw import PARALLEL_MIN_ROWS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -163,50 +173,95 @@ _D = np.array([
 ])
 
 
+#: Smallest positive normal double: below it a number has lost precision.
+_TINY = 2.2250738585072014e-308
+
+
 @nb.njit(**_JIT)
-def _deflection_scale(family, params, mass, velocity):
-    """δ_ref [m]: maximum deflection of the law's elastic part without
-    damping (energy balance ½ m v0² = ∫ F_el dδ); the error scale of δ."""
-    energy = 0.5 * mass * velocity * velocity
+def _normal(x):
+    """x is a positive, finite, normal double."""
+    return x >= _TINY and x < math.inf
+
+
+@nb.njit(**_JIT)
+def _scales(family, params, mass, velocity, scaled):
+    """(ok, δ_ref [m], t_ref [s], F_ref [N]) of one impact, and in ``scaled``
+    the law's parameters in these units, where m = v0 = δ_ref = 1.
+
+    δ_ref is the maximum deflection of the law's elastic part without damping
+    (½ m v0² = ∫ F_el dδ), written without v0² so that it does not underflow
+    before the scales do; t_ref = δ_ref/v0 and F_ref = m v0/t_ref.  The
+    elastic coefficient becomes (n+1)/2, 1 or 5/4, and the damping its
+    dimensionless group: c v0, b t_ref/m = 2ζ, B/t_ref, η δ_ref^(1/4) t_ref/m.
+    ``ok`` is False where a scale, the energy scale m v0² or a scaled
+    parameter is not a finite normal number (the impact's scales under- or
+    overflow), or without an elastic part (the fruit never comes back)."""
     if family == POWER_LAW:
         n = params[1]
-        scale = ((n + 1.0) * energy / params[0]) ** (1.0 / (n + 1.0))
+        delta_ref = (0.5 * (n + 1.0) * mass / params[0]) ** (1.0 / (n + 1.0)) * velocity ** (2.0 / (n + 1.0))
     elif family == KELVIN_VOIGT:
-        scale = math.sqrt(2.0 * energy / params[0])
+        delta_ref = velocity * math.sqrt(mass / params[0])
     else:  # Kuwabara–Kono and Tsuji: elastic part K δ^1.5
-        scale = (2.5 * energy / params[0]) ** 0.4
-    if not (scale > 0.0 and scale < math.inf):
-        scale = velocity * 1e-3  # no elastic part: any positive scale works
-    return scale
+        delta_ref = (1.25 * mass / params[0]) ** 0.4 * velocity ** 0.8
+    time_ref = delta_ref / velocity
+    force_ref = mass * velocity / time_ref
+    scaled[2] = 0.0
+    if family == POWER_LAW:
+        scaled[0] = 0.5 * (params[1] + 1.0)
+        scaled[1] = params[1]
+        scaled[2] = params[2] * velocity
+    elif family == KELVIN_VOIGT:
+        scaled[0] = 1.0
+        scaled[1] = params[1] * time_ref / mass
+    elif family == KUWABARA_KONO:
+        scaled[0] = 1.25
+        scaled[1] = params[1] / time_ref
+    else:  # TSUJI
+        scaled[0] = 1.25
+        scaled[1] = params[1] * time_ref / mass * math.sqrt(math.sqrt(delta_ref))
+    ok = (_normal(mass) and _normal(velocity) and _normal(delta_ref) and _normal(time_ref)
+          and _normal(force_ref) and _normal(mass * velocity * velocity))
+    for j in range(3):
+        ok = ok and abs(scaled[j]) < math.inf
+    return ok, delta_ref, time_ref, force_ref
 
 
 @nb.njit(**_JIT)
-def _rates(family, params, clamp, inv_mass, d, v):
-    """(F, δ·dF/dt, δ²·d(F/δ)/dt) at the state (δ, δ̇), F the force that
-    drives the motion (clamped if ``clamp``).  dF/dt = F_δ δ̇ + F_δ̇ δ̈ with
-    δ̈ = -F/m; the factors δ and δ² keep both finite at δ = 0."""
+def _rates(family, params, clamp, d, v):
+    """(F, g, r) at the state (δ, δ̇): F the force that drives the motion
+    (clamped if ``clamp``), g = δ^a·dF/dt and r = δ^b·d(F/δ)/dt with the
+    smallest powers that keep them finite at δ = 0 (a, b = 1 - n, 2 - n for
+    the power law; 0, 2 Kelvin–Voigt; 1/2, 3/2 Kuwabara–Kono; 3/4, 7/4
+    Tsuji).  They have the signs of the rates, and at first touch they are
+    the rates' leading terms instead of 0, so an extremum inside the first
+    step is bracketed from its start.  dF/dt = F_δ δ̇ + F_δ̇ δ̈, δ̈ = -F (m = 1,
+    as everywhere inside the integration: see ``_scales``)."""
     force = contact_force(family, params, d, v, clamp)
     if d < 0.0:
         d = 0.0
     if clamp and force <= 0.0:
         return force, 0.0, 0.0
+    a = -force
     if family == POWER_LAW:
-        elastic = params[0] * d ** params[1]
-        d_fd = params[1] * force
-        d_fv = d * elastic * params[2]
+        # F = K δ^n (1 + c δ̇):  dF/dt = K δ^(n-1) [n δ̇ (1 + c δ̇) + c δ δ̈]
+        rise = v * (1.0 + params[2] * v)
+        dash = params[2] * d * a
+        g = params[0] * (params[1] * rise + dash)
+        r = params[0] * ((params[1] - 1.0) * rise + dash)
     elif family == KELVIN_VOIGT:
-        d_fd = params[0] * d
-        d_fv = params[1] * d
+        # F = k δ + b δ̇:  dF/dt = k δ̇ + b δ̈,  δ² d(F/δ)/dt = b (δ δ̈ - δ̇²)
+        g = params[0] * v + params[1] * a
+        r = params[1] * (d * a - v * v)
     elif family == KUWABARA_KONO:
-        root = math.sqrt(d)
-        d_fd = params[0] * root * (1.5 * d + 0.5 * params[1] * v)
-        d_fv = params[0] * params[1] * d * root
+        # F = K (δ^1.5 + B δ^0.5 δ̇):  δ^0.5 dF/dt = K (1.5 δ δ̇ + B (0.5 δ̇² + δ δ̈))
+        g = params[0] * (1.5 * d * v + params[1] * (0.5 * v * v + d * a))
+        r = params[0] * (0.5 * d * v + params[1] * (d * a - 0.5 * v * v))
     else:  # TSUJI
-        quarter = math.sqrt(math.sqrt(d))
-        d_fd = 1.5 * params[0] * d * math.sqrt(d) + 0.25 * params[1] * quarter * v
-        d_fv = params[1] * d * quarter
-    g = d_fd * v - d_fv * force * inv_mass
-    return force, g, g - force * v
+        # F = K δ^1.5 + η δ^0.25 δ̇:  δ^0.75 dF/dt = 1.5 K δ^1.25 δ̇ + η (0.25 δ̇² + δ δ̈)
+        elastic = params[0] * d * math.sqrt(math.sqrt(d)) * v
+        g = 1.5 * elastic + params[1] * (0.25 * v * v + d * a)
+        r = 0.5 * elastic + params[1] * (d * a - 0.75 * v * v)
+    return force, g, r
 
 
 @nb.njit(**_JIT)
@@ -266,15 +321,15 @@ def _substitution_power(family, params):
 
 
 @nb.njit(**_JIT)
-def _rhs(mode, q, family, params, inv_mass, x, y1, y2):
-    """Right-hand side.  mode 0: x = t, y = (δ, δ̇), y' = (δ̇, -F/m).
-    mode 1: x = σ = δ^(1/q), y = (t, δ̇), dy/dσ = (1, -F/m)·q σ^(q-1)/δ̇.
+def _rhs(mode, q, family, params, x, y1, y2):
+    """Right-hand side (m = 1).  mode 0: x = t, y = (δ, δ̇), y' = (δ̇, -F).
+    mode 1: x = σ = δ^(1/q), y = (t, δ̇), dy/dσ = (1, -F)·q σ^(q-1)/δ̇.
     F is the unclamped law: until separation a clamped law equals it (it is
     positive in compression, and contact ends where it first vanishes in
     restitution), and its smooth continuation past that event lets the
     event be located on a smooth interpolant instead of across a kink."""
     if mode == 0:
-        return y2, -contact_force(family, params, y1, y2, False) * inv_mass
+        return y2, -contact_force(family, params, y1, y2, False)
     s = x if x > 0.0 else 0.0
     if q == 1:
         p = 1.0
@@ -283,11 +338,11 @@ def _rhs(mode, q, family, params, inv_mass, x, y1, y2):
     else:
         p = s * s * s
     w = q * p / y2
-    return w, -contact_force(family, params, p * s, y2, False) * inv_mass * w
+    return w, -contact_force(family, params, p * s, y2, False) * w
 
 
 @nb.njit(**_JIT)
-def _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2):
+def _step(mode, q, family, params, x, y1, y2, h, k1, k2):
     """One DOP853 step of size h from (x, y) with k1[0], k2[0] = f(x, y) set.
     Fills stages 1–12 (12: f at the new point) and returns the new y.
     Written out over the nonzero coefficients: twice as fast as loops."""
@@ -295,50 +350,50 @@ def _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2):
     b0 = k2[0]
     d1 = y1 + h * (_A[1, 0] * a0)
     d2 = y2 + h * (_A[1, 0] * b0)
-    a1, b1 = _rhs(mode, q, family, params, inv_mass, x + _C[1] * h, d1, d2)
+    a1, b1 = _rhs(mode, q, family, params, x + _C[1] * h, d1, d2)
     d1 = y1 + h * (_A[2, 0] * a0 + _A[2, 1] * a1)
     d2 = y2 + h * (_A[2, 0] * b0 + _A[2, 1] * b1)
-    a2, b2 = _rhs(mode, q, family, params, inv_mass, x + _C[2] * h, d1, d2)
+    a2, b2 = _rhs(mode, q, family, params, x + _C[2] * h, d1, d2)
     d1 = y1 + h * (_A[3, 0] * a0 + _A[3, 2] * a2)
     d2 = y2 + h * (_A[3, 0] * b0 + _A[3, 2] * b2)
-    a3, b3 = _rhs(mode, q, family, params, inv_mass, x + _C[3] * h, d1, d2)
+    a3, b3 = _rhs(mode, q, family, params, x + _C[3] * h, d1, d2)
     d1 = y1 + h * (_A[4, 0] * a0 + _A[4, 2] * a2 + _A[4, 3] * a3)
     d2 = y2 + h * (_A[4, 0] * b0 + _A[4, 2] * b2 + _A[4, 3] * b3)
-    a4, b4 = _rhs(mode, q, family, params, inv_mass, x + _C[4] * h, d1, d2)
+    a4, b4 = _rhs(mode, q, family, params, x + _C[4] * h, d1, d2)
     d1 = y1 + h * (_A[5, 0] * a0 + _A[5, 3] * a3 + _A[5, 4] * a4)
     d2 = y2 + h * (_A[5, 0] * b0 + _A[5, 3] * b3 + _A[5, 4] * b4)
-    a5, b5 = _rhs(mode, q, family, params, inv_mass, x + _C[5] * h, d1, d2)
+    a5, b5 = _rhs(mode, q, family, params, x + _C[5] * h, d1, d2)
     d1 = y1 + h * (_A[6, 0] * a0 + _A[6, 3] * a3 + _A[6, 4] * a4 + _A[6, 5] * a5)
     d2 = y2 + h * (_A[6, 0] * b0 + _A[6, 3] * b3 + _A[6, 4] * b4 + _A[6, 5] * b5)
-    a6, b6 = _rhs(mode, q, family, params, inv_mass, x + _C[6] * h, d1, d2)
+    a6, b6 = _rhs(mode, q, family, params, x + _C[6] * h, d1, d2)
     d1 = y1 + h * (_A[7, 0] * a0 + _A[7, 3] * a3 + _A[7, 4] * a4 + _A[7, 5] * a5 + _A[7, 6] * a6)
     d2 = y2 + h * (_A[7, 0] * b0 + _A[7, 3] * b3 + _A[7, 4] * b4 + _A[7, 5] * b5 + _A[7, 6] * b6)
-    a7, b7 = _rhs(mode, q, family, params, inv_mass, x + _C[7] * h, d1, d2)
+    a7, b7 = _rhs(mode, q, family, params, x + _C[7] * h, d1, d2)
     d1 = y1 + h * (_A[8, 0] * a0 + _A[8, 3] * a3 + _A[8, 4] * a4 + _A[8, 5] * a5 + _A[8, 6] * a6
             + _A[8, 7] * a7)
     d2 = y2 + h * (_A[8, 0] * b0 + _A[8, 3] * b3 + _A[8, 4] * b4 + _A[8, 5] * b5 + _A[8, 6] * b6
             + _A[8, 7] * b7)
-    a8, b8 = _rhs(mode, q, family, params, inv_mass, x + _C[8] * h, d1, d2)
+    a8, b8 = _rhs(mode, q, family, params, x + _C[8] * h, d1, d2)
     d1 = y1 + h * (_A[9, 0] * a0 + _A[9, 3] * a3 + _A[9, 4] * a4 + _A[9, 5] * a5 + _A[9, 6] * a6
             + _A[9, 7] * a7 + _A[9, 8] * a8)
     d2 = y2 + h * (_A[9, 0] * b0 + _A[9, 3] * b3 + _A[9, 4] * b4 + _A[9, 5] * b5 + _A[9, 6] * b6
             + _A[9, 7] * b7 + _A[9, 8] * b8)
-    a9, b9 = _rhs(mode, q, family, params, inv_mass, x + _C[9] * h, d1, d2)
+    a9, b9 = _rhs(mode, q, family, params, x + _C[9] * h, d1, d2)
     d1 = y1 + h * (_A[10, 0] * a0 + _A[10, 3] * a3 + _A[10, 4] * a4 + _A[10, 5] * a5 + _A[10, 6] * a6
             + _A[10, 7] * a7 + _A[10, 8] * a8 + _A[10, 9] * a9)
     d2 = y2 + h * (_A[10, 0] * b0 + _A[10, 3] * b3 + _A[10, 4] * b4 + _A[10, 5] * b5 + _A[10, 6] * b6
             + _A[10, 7] * b7 + _A[10, 8] * b8 + _A[10, 9] * b9)
-    a10, b10 = _rhs(mode, q, family, params, inv_mass, x + _C[10] * h, d1, d2)
+    a10, b10 = _rhs(mode, q, family, params, x + _C[10] * h, d1, d2)
     d1 = y1 + h * (_A[11, 0] * a0 + _A[11, 3] * a3 + _A[11, 4] * a4 + _A[11, 5] * a5 + _A[11, 6] * a6
             + _A[11, 7] * a7 + _A[11, 8] * a8 + _A[11, 9] * a9 + _A[11, 10] * a10)
     d2 = y2 + h * (_A[11, 0] * b0 + _A[11, 3] * b3 + _A[11, 4] * b4 + _A[11, 5] * b5 + _A[11, 6] * b6
             + _A[11, 7] * b7 + _A[11, 8] * b8 + _A[11, 9] * b9 + _A[11, 10] * b10)
-    a11, b11 = _rhs(mode, q, family, params, inv_mass, x + _C[11] * h, d1, d2)
+    a11, b11 = _rhs(mode, q, family, params, x + _C[11] * h, d1, d2)
     y1_new = y1 + h * (_B[0] * a0 + _B[5] * a5 + _B[6] * a6 + _B[7] * a7 + _B[8] * a8 + _B[9] * a9
             + _B[10] * a10 + _B[11] * a11)
     y2_new = y2 + h * (_B[0] * b0 + _B[5] * b5 + _B[6] * b6 + _B[7] * b7 + _B[8] * b8 + _B[9] * b9
             + _B[10] * b10 + _B[11] * b11)
-    a12, b12 = _rhs(mode, q, family, params, inv_mass, x + h, y1_new, y2_new)
+    a12, b12 = _rhs(mode, q, family, params, x + h, y1_new, y2_new)
     k1[1] = a1
     k2[1] = b1
     k1[2] = a2
@@ -367,8 +422,9 @@ def _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2):
 
 
 @nb.njit(**_JIT)
-def _error_norm(k1, k2, h, scale1, scale2):
-    """DOP853's combined 5th/3rd-order error estimate (≤ 1: accept)."""
+def _error_norm(k1, k2, h, rtol):
+    """DOP853's combined 5th/3rd-order error estimate (≤ 1: accept), every
+    component measured against rtol (the state is in units of the impact)."""
     e51 = 0.0
     e52 = 0.0
     e31 = 0.0
@@ -378,10 +434,10 @@ def _error_norm(k1, k2, h, scale1, scale2):
         e52 += _E5[j] * k2[j]
         e31 += _E3[j] * k1[j]
         e32 += _E3[j] * k2[j]
-    e51 /= scale1
-    e52 /= scale2
-    e31 /= scale1
-    e32 /= scale2
+    e51 /= rtol
+    e52 /= rtol
+    e31 /= rtol
+    e32 /= rtol
     err5 = e51 * e51 + e52 * e52
     err3 = e31 * e31 + e32 * e32
     if err5 == 0.0 and err3 == 0.0:
@@ -390,7 +446,7 @@ def _error_norm(k1, k2, h, scale1, scale2):
 
 
 @nb.njit(**_JIT)
-def _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2):
+def _dense_setup(mode, q, family, params, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2):
     """Coefficients of DOP853's 7th-order interpolant on the last step
     (three more stages)."""
     for s in range(13, 16):
@@ -400,7 +456,7 @@ def _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new
             a = _A[s, j]
             s1 += a * k1[j]
             s2 += a * k2[j]
-        k1[s], k2[s] = _rhs(mode, q, family, params, inv_mass, x + _C[s] * h, y1 + h * s1, y2 + h * s2)
+        k1[s], k2[s] = _rhs(mode, q, family, params, x + _C[s] * h, y1 + h * s1, y2 + h * s2)
     d1 = y1_new - y1
     d2 = y2_new - y2
     c1[0] = d1
@@ -446,9 +502,9 @@ def _state(mode, q, theta, x, h, y1, y2, c1, c2):
 
 
 @nb.njit(**_JIT)
-def _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
-    """Event function at θ: 1 δ̇, 2 δ·dF/dt, 3 δ²·d(F/δ)/dt, 4 the sign of
-    the unclamped F (``_release``), 5 t - target."""
+def _event(kind, theta, target, mode, q, family, params, clamp, x, h, y1, y2, c1, c2):
+    """Event function at θ: 1 δ̇, 2 dF/dt and 3 d(F/δ)/dt (scaled as in
+    ``_rates``), 4 the sign of the unclamped F (``_release``), 5 t - target."""
     t, d, v = _state(mode, q, theta, x, h, y1, y2, c1, c2)
     if kind == 1:
         return v
@@ -456,25 +512,25 @@ def _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, 
         return _release(family, params, d, v)
     if kind == 5:
         return t - target
-    force, g, hp = _rates(family, params, clamp, inv_mass, d, v)
+    force, g, hp = _rates(family, params, clamp, d, v)
     return g if kind == 2 else hp
 
 
 @nb.njit(**_JIT)
-def _locate(kind, theta_end, f_end, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
+def _locate(kind, theta_end, f_end, mode, q, family, params, clamp, x, h, y1, y2, c1, c2):
     """(t, δ, δ̇) where event ``kind`` (2: dF/dt, 3: d(F/δ)/dt) vanishes inside the
     last step, from its value at the step start and ``f_end`` at ``theta_end``."""
-    f_start = _event(kind, 0.0, 0.0, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
-    theta = _root(kind, 0.0, f_start, theta_end, f_end, 0.0, mode, q, family, params, clamp, inv_mass,
+    f_start = _event(kind, 0.0, 0.0, mode, q, family, params, clamp, x, h, y1, y2, c1, c2)
+    theta = _root(kind, 0.0, f_start, theta_end, f_end, 0.0, mode, q, family, params, clamp,
                   x, h, y1, y2, c1, c2)
     return _state(mode, q, theta, x, h, y1, y2, c1, c2)
 
 
 @nb.njit(**_JIT)
-def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2):
+def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, x, h, y1, y2, c1, c2):
     """θ in [lo, hi] where event ``kind`` changes sign (f_lo, f_hi of
     opposite signs or zero), by the Illinois variant of regula falsi,
-    to 1e-13 in θ (the step is a fraction of the contact)."""
+    to 1e-13 of θ (the step is a fraction of the contact)."""
     if f_lo == 0.0:
         return lo
     if f_hi == 0.0:
@@ -485,7 +541,7 @@ def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, inv_
         theta = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
         if not (lo < theta < hi):
             theta = 0.5 * (lo + hi)
-        f = _event(kind, theta, target, mode, q, family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+        f = _event(kind, theta, target, mode, q, family, params, clamp, x, h, y1, y2, c1, c2)
         if f == 0.0:
             return theta
         if (f > 0.0) == (f_hi > 0.0):
@@ -500,7 +556,7 @@ def _root(kind, lo, f_lo, hi, f_hi, target, mode, q, family, params, clamp, inv_
             if side == -1:
                 f_hi *= 0.5
             side = -1
-        if hi - lo <= 1e-13:  # θ; event times to ~1e-14 of the contact
+        if hi - lo <= 1e-13 * hi:  # relative: an event near θ = 0 is found to its own size
             break
     return theta
 
@@ -516,41 +572,51 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
                times, curve_d, curve_v, curve_f, work):
     """Integrate one impact; fill ``out`` (characteristics) and, at the
     ascending ``times`` [s], the curves.  Returns the number of accepted
-    steps, or -1 (too many steps) / -2 (step size underflow).
+    steps, or -1 (too many steps) / -2 (step size underflow) / -3 (scales
+    or results not representable, see ``_scales``), with NaNs.
+
+    The integration runs in units of the impact (``_scales``: m = v0 =
+    δ_ref = 1), so that it is the same for every impact with the same
+    dimensionless damping and nothing inside it under- or overflows; results
+    are scaled back at the end, and NaN if one of them is then subnormal or
+    infinite (other than an unbounded pressure) or a time, deflection or
+    force underflows to 0.
 
     Three phases: (A) from first touch in σ = δ^(1/q), state (t, δ̇);
     (B) in time, state (δ, δ̇), through the maximum deflection; (C) in σ
     again, down to σ = 0 (separation) unless a clamped force vanishes first.
     In σ the laws are polynomials and the motion is smooth up to δ = 0."""
-    inv_mass = 1.0 / mass
-    q = _substitution_power(family, params)
-    delta_ref = _deflection_scale(family, params, mass, velocity)
-    time_scale = delta_ref / velocity
-    scale_v = rtol * velocity
     k1 = work[0:16]  # stages
     k2 = work[16:32]
     c1 = work[32:39]  # interpolant coefficients
     c2 = work[39:46]
+    scaled = work[46:49]  # the law's parameters in units of the impact
+    ok, delta_ref, time_ref, force_ref = _scales(family, params, mass, velocity, scaled)
+    if not ok:
+        return _fail(out, curve_d, curve_v, curve_f, 0, -3)
+    q = _substitution_power(family, scaled)
 
-    force0 = contact_force(family, params, 0.0, velocity, clamp)
+    # F at first touch, and the signs of dF/dt and d(F/δ)/dt just after it: the
+    # rates' leading terms, 0 only without a dashpot, where F and F/δ rise from
+    # 0 (Hertz) or stay constant (F/δ = k, or K(1 + c v0) for n = 1)
+    force0, g_old, h_old = _rates(family, scaled, clamp, 0.0, 1.0)
     peak_force = force0
     time_to_peak = 0.0
     max_deflection = 0.0
     time_to_max = 0.0
-    max_ratio = _ratio_limit(family, params, clamp, velocity)
-    # signs of dF/dt and d(F/δ)/dt just after first touch
-    if family == KELVIN_VOIGT:
-        g_old = params[0] * velocity - params[1] * force0 * inv_mass
-    else:
+    max_ratio = _ratio_limit(family, scaled, clamp, 1.0)
+    touch_force = contact_force(family, params, 0.0, velocity, clamp)  # F(0) [N] exactly (b v0)
+    if g_old == 0.0 and force0 == 0.0:
         g_old = 1.0
-    h_old = 1.0 if max_ratio == 0.0 else -1.0
+    if h_old == 0.0 and max_ratio == 0.0:
+        h_old = 1.0
 
     n_times = times.shape[0]
     ti = 0
     while ti < n_times and times[ti] <= 0.0:
         curve_d[ti] = 0.0
         curve_v[ti] = velocity
-        curve_f[ti] = force0
+        curve_f[ti] = touch_force
         ti += 1
 
     # phase A: x = σ, y = (t, δ̇)
@@ -558,10 +624,9 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
     mode = 1
     x = 0.0
     y1 = 0.0
-    y2 = velocity
-    sigma_end = (_SWITCH_A * delta_ref) ** (1.0 / q)
-    scale1 = rtol * time_scale
-    k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+    y2 = 1.0
+    sigma_end = _SWITCH_A ** (1.0 / q)
+    k1[0], k2[0] = _rhs(mode, q, family, scaled, x, y1, y2)
     h = sigma_end
     rejected = False
     steps = 0
@@ -581,8 +646,8 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
                 reach = 2.0 * gap / (-y2 + math.sqrt(y2 * y2 + 2.0 * abs(k2[0]) * gap))
                 if h > reach:
                     h = reach
-        y1_new, y2_new = _step(mode, q, family, params, inv_mass, x, y1, y2, h, k1, k2)
-        err = _error_norm(k1, k2, h, scale1, scale_v)
+        y1_new, y2_new = _step(mode, q, family, scaled, x, y1, y2, h, k1, k2)
+        err = _error_norm(k1, k2, h, rtol)
         if not (err <= 1.0):  # also catches NaN
             factor = _MIN_FACTOR if err != err else max(_MIN_FACTOR, _SAFETY * err ** -0.125)
             h *= factor
@@ -600,7 +665,7 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             s_new = x + h if not clipped or phase == 0 else 0.0
             d_new = s_new ** q
         v_new = y2_new
-        f_raw = _release(family, params, d_new, v_new)
+        f_raw = _release(family, scaled, d_new, v_new)
         ended = clamp and f_raw <= 0.0 and v_new < 0.0
         if not ended and phase == 1 and v_new < 0.0 and d_new < _SWITCH_C * max_deflection:
             # entering the last phase: land in (0.3, 1)·δ_switch, not past separation
@@ -617,45 +682,50 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         d_end = d_new
         v_end = v_new
         if ended:  # clamped force vanishes: separation with δ > 0
-            _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
+            _dense_setup(mode, q, family, scaled, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
             dense_ready = True
             d_start = y1 if mode == 0 else x ** q
-            f_start = _release(family, params, d_start, y2)
-            theta_end = _root(4, 0.0, f_start, 1.0, f_raw, 0.0, mode, q, family, params, clamp, inv_mass,
+            f_start = _release(family, scaled, d_start, y2)
+            theta_end = _root(4, 0.0, f_start, 1.0, f_raw, 0.0, mode, q, family, scaled, clamp,
                               x, h, y1, y2, c1, c2)
-            t_end, d_end, v_end = _state(mode, q, theta_end, x, h, y1, y2, c1, c2)
-            d_end = max(d_end, 0.0)
+            # the state there from a step of θh (8th order; the interpolant is 7th):
+            # the exit velocity is the restitution, and F = 0 makes it insensitive to θ
+            y1_end, v_end = _step(mode, q, family, scaled, x, y1, y2, theta_end * h, k1, k2)
+            if mode == 0:
+                t_end, d_end = x + theta_end * h, max(y1_end, 0.0)
+            else:
+                t_end, d_end = y1_end, (x + theta_end * h) ** q
         elif phase == 2 and clipped:  # σ = 0: separation at δ = 0
             ended = True
             d_end = 0.0
 
         if mode == 0 and y2 > 0.0 and v_end <= 0.0:  # maximum deflection
             if not dense_ready:
-                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                _dense_setup(mode, q, family, scaled, x, y1, y2, h, y1_new, y2_new,
                              k1, k2, c1, c2)
                 dense_ready = True
-            theta = _root(1, 0.0, y2, theta_end, v_end, 0.0, mode, q, family, params, clamp, inv_mass,
+            theta = _root(1, 0.0, y2, theta_end, v_end, 0.0, mode, q, family, scaled, clamp,
                           x, h, y1, y2, c1, c2)
             time_to_max, max_deflection, _v = _state(mode, q, theta, x, h, y1, y2, c1, c2)
 
-        force_end, g_end, h_end = _rates(family, params, clamp, inv_mass, d_end, v_end)
+        force_end, g_end, h_end = _rates(family, scaled, clamp, d_end, v_end)
         force_peak = g_old > 0.0 and g_end < 0.0  # local maximum of F in this step
         ratio_peak = h_old > 0.0 and h_end < 0.0  # local maximum of F/δ in this step
         if (force_peak or ratio_peak) and not dense_ready:
-            _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
+            _dense_setup(mode, q, family, scaled, x, y1, y2, h, y1_new, y2_new, k1, k2, c1, c2)
             dense_ready = True
         if force_peak:
-            tt, dd, vv = _locate(2, theta_end, g_end, mode, q, family, params, clamp, inv_mass, x, h,
+            tt, dd, vv = _locate(2, theta_end, g_end, mode, q, family, scaled, clamp, x, h,
                                  y1, y2, c1, c2)
-            force = contact_force(family, params, dd, vv, clamp)
+            force = contact_force(family, scaled, dd, vv, clamp)
             if force > peak_force:
                 peak_force = force
                 time_to_peak = tt
         if ratio_peak:
-            tt, dd, vv = _locate(3, theta_end, h_end, mode, q, family, params, clamp, inv_mass, x, h,
+            tt, dd, vv = _locate(3, theta_end, h_end, mode, q, family, scaled, clamp, x, h,
                                  y1, y2, c1, c2)
             if dd > 0.0:
-                ratio = contact_force(family, params, dd, vv, clamp) / dd
+                ratio = contact_force(family, scaled, dd, vv, clamp) / dd
                 if ratio > max_ratio:
                     max_ratio = ratio
         if g_end != 0.0:
@@ -663,36 +733,44 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         if h_end != 0.0:
             h_old = h_end
 
-        while ti < n_times and times[ti] < t_end:
+        while ti < n_times and times[ti] < t_end * time_ref:
             if not dense_ready:
-                _dense_setup(mode, q, family, params, inv_mass, x, y1, y2, h, y1_new, y2_new,
+                _dense_setup(mode, q, family, scaled, x, y1, y2, h, y1_new, y2_new,
                              k1, k2, c1, c2)
                 dense_ready = True
+            tau = times[ti] / time_ref
             if mode == 0:
-                theta = (times[ti] - x) / h
+                theta = (tau - x) / h
             else:
-                theta = _root(5, 0.0, y1 - times[ti], theta_end, t_end - times[ti], times[ti], mode, q,
-                              family, params, clamp, inv_mass, x, h, y1, y2, c1, c2)
+                theta = _root(5, 0.0, y1 - tau, theta_end, t_end - tau, tau, mode, q,
+                              family, scaled, clamp, x, h, y1, y2, c1, c2)
             tt, dd, vv = _state(mode, q, theta, x, h, y1, y2, c1, c2)
-            curve_d[ti] = max(dd, 0.0)
-            curve_v[ti] = vv
-            curve_f[ti] = contact_force(family, params, dd, vv, clamp)
+            curve_d[ti] = max(dd, 0.0) * delta_ref
+            curve_v[ti] = vv * velocity
+            curve_f[ti] = contact_force(family, scaled, dd, vv, clamp) * force_ref
             ti += 1
 
         if ended:
             while ti < n_times:
-                curve_d[ti] = d_end
-                curve_v[ti] = v_end
+                curve_d[ti] = d_end * delta_ref
+                curve_v[ti] = v_end * velocity
                 curve_f[ti] = 0.0
                 ti += 1
             if d_end > 0.0:
                 ratio = force_end / d_end
             else:
-                ratio = _ratio_limit(family, params, clamp, v_end)
+                ratio = _ratio_limit(family, scaled, clamp, v_end)
             if ratio > max_ratio:
                 max_ratio = ratio
-            fill_characteristics(out, peak_force, time_to_peak, t_end, max_deflection, time_to_max,
-                                 -v_end, velocity, mass, max_ratio, radius)
+            if time_to_peak > 0.0:
+                peak_force *= force_ref
+            else:
+                peak_force = touch_force
+            fill_characteristics(out, peak_force, time_to_peak * time_ref, t_end * time_ref,
+                                 max_deflection * delta_ref, time_to_max * time_ref, -v_end * velocity,
+                                 velocity, mass, max_ratio * (force_ref / delta_ref), radius)
+            if not _representable(out, max_ratio):
+                return _fail(out, curve_d, curve_v, curve_f, 0, -3)
             return steps
 
         # ---- advance, switching phase where due ----
@@ -700,7 +778,7 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
         if rejected:
             factor = min(1.0, factor)
             rejected = False
-        if phase == 0 and (clipped or v_new <= 0.5 * velocity):
+        if phase == 0 and (clipped or v_new <= 0.5):
             # to time: dt = (dt/dσ) dσ
             h = factor * h * q * (x + h) ** (q - 1) / v_new
             phase = 1
@@ -708,8 +786,7 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             x = t_new
             y1 = d_new
             y2 = v_new
-            scale1 = rtol * delta_ref
-            k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+            k1[0], k2[0] = _rhs(mode, q, family, scaled, x, y1, y2)
         elif phase == 1 and v_new < 0.0 and d_new < _SWITCH_C * max_deflection:
             phase = 2
             mode = 1
@@ -717,8 +794,7 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             h = -factor * h * abs(v_new) / (q * x ** (q - 1))
             y1 = t_new
             y2 = v_new
-            scale1 = rtol * time_scale
-            k1[0], k2[0] = _rhs(mode, q, family, params, inv_mass, x, y1, y2)
+            k1[0], k2[0] = _rhs(mode, q, family, scaled, x, y1, y2)
         else:
             x += h
             y1 = y1_new
@@ -727,16 +803,45 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
             k2[0] = k2[12]
             h *= factor
 
+    return _fail(out, curve_d, curve_v, curve_f, ti, -1 if steps >= MAX_STEPS else -2)
+
+
+@nb.njit(**_JIT)
+def _representable(out, max_ratio):
+    """The scaled-back characteristics kept their precision: none subnormal
+    or infinite (but an unbounded pressure, F/δ → ∞ at first touch), and
+    none 0 but the time to a peak at first touch or the energy absorbed
+    in an elastic impact."""
+    for j in range(out.shape[0]):
+        value = abs(out[j])
+        if value == math.inf:
+            if j != MAX_PRESSURE or max_ratio != math.inf:
+                return False
+        elif value == 0.0:
+            if j != TIME_TO_PEAK and j != ABSORBED_ENERGY:
+                return False
+        elif value < _TINY:
+            return False
+    return True
+
+
+@nb.njit(**_JIT)
+def _fail(out, curve_d, curve_v, curve_f, first, code):
+    """NaN characteristics, and NaN curve samples from index ``first``; returns ``code``."""
     for j in range(out.shape[0]):
         out[j] = math.nan
-    for j in range(ti, n_times):
+    for j in range(first, curve_d.shape[0]):
         curve_d[j] = math.nan
         curve_v[j] = math.nan
         curve_f[j] = math.nan
-    return -1 if steps >= MAX_STEPS else -2
+    return code
 
 
-_WORK = 46  # workspace: 2 × 16 stages, 2 × 7 interpolant coefficients
+#: Up to this many rows ``adaptive_characteristics`` stays on one thread: the
+#: work of PARALLEL_MIN_ROWS power-law rows (an adaptive impact costs about ten).
+SERIAL_MAX_ROWS = PARALLEL_MIN_ROWS // 10
+
+_WORK = 49  # workspace: 2 × 16 stages, 2 × 7 interpolant coefficients, 3 scaled parameters
 _CHUNK = 64  # impacts per parallel work item
 
 
@@ -752,7 +857,8 @@ def adaptive_impact(family, params, clamp, mass, velocity, radius, rtol, out):
 
     Fills ``out`` (length ≥ 12) in the order of ``CHARACTERISTIC_COLUMNS``.
     Returns the number of accepted steps (> 0), or a negative number (and
-    NaNs in ``out``) if the integration failed."""
+    NaNs in ``out``) if the integration failed or the impact's scales are not
+    representable in double precision (``_integrate``)."""
     none = out[:0]  # no curve samples (an empty, writable view)
     return _integrate(family, params, clamp, mass, velocity, radius, rtol, out, none, none, none, none,
                       np.empty(_WORK))
@@ -770,6 +876,17 @@ def adaptive_batch(family, params, clamp, mass, velocity, radius, rtol, out):
             none = out[i, :0]
             _integrate(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], rtol, out[i],
                        none, none, none, none, work)
+
+
+@nb.njit(**_JIT)
+def adaptive_batch_serial(family, params, clamp, mass, velocity, radius, rtol, out):
+    """``adaptive_batch`` on one thread, for few rows: starting the threads
+    costs more than the work (milliseconds when the other cores are busy)."""
+    work = np.empty(_WORK)
+    for i in range(mass.shape[0]):
+        none = out[i, :0]
+        _integrate(family[i], params[i], clamp[i], mass[i], velocity[i], radius[i], rtol, out[i],
+                   none, none, none, none, work)
 
 
 @nb.njit(**_JIT)
@@ -800,7 +917,8 @@ def adaptive_characteristics(family, params, clamp, mass, velocity, radius,
     ndarray, shape (rows, len(CHARACTERISTIC_COLUMNS))
         Inputs broadcast together (params along its leading axes) and
         flattened to rows.  Rows whose integration failed are NaN.
-        Inputs are not validated here: validate at the boundary.
+        Inputs are not validated here: validate at the boundary.  Up to
+        ``SERIAL_MAX_ROWS`` rows run on one thread (``adaptive_batch_serial``).
     """
     params = np.asarray(params, dtype=float)
     if params.ndim == 0:
@@ -815,7 +933,8 @@ def adaptive_characteristics(family, params, clamp, mass, velocity, radius,
     table = np.zeros((rows, n_params))
     table[:, :params.shape[-1]] = np.broadcast_to(params, shape + params.shape[-1:]).reshape(rows, -1)
     out = np.empty((rows, N_CHARACTERISTICS))
-    adaptive_batch(scalars[0], table, scalars[1], scalars[2], scalars[3], scalars[4], float(rtol), out)
+    kernel = adaptive_batch if rows > SERIAL_MAX_ROWS else adaptive_batch_serial
+    kernel(scalars[0], table, scalars[1], scalars[2], scalars[3], scalars[4], float(rtol), out)
     return out
 
 
@@ -849,5 +968,5 @@ def adaptive_curves(family: int, params, clamp: bool, mass: float, velocity: flo
             float(out[2]))
 
 
-__all__ = ["adaptive_impact", "adaptive_batch", "adaptive_characteristics", "adaptive_curves",
+__all__ = ["adaptive_impact", "adaptive_batch", "adaptive_batch_serial", "adaptive_characteristics", "adaptive_curves",
            "CHARACTERISTIC_COLUMNS", "N_CHARACTERISTICS", "DEFAULT_RTOL"]

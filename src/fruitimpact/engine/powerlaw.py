@@ -83,6 +83,20 @@ def r_func(s):
 
 
 @nb.njit(**_JIT)
+def _r_many(x, out):
+    for i in range(x.shape[0]):
+        out[i] = r_func(x[i])
+
+
+def r_array(x) -> np.ndarray:
+    """``r_func`` of each element of ``x`` (a serial loop: for the few rows of a self-check)."""
+    x = np.ascontiguousarray(np.atleast_1d(np.asarray(x, dtype=float)).ravel())
+    out = np.empty_like(x)
+    _r_many(x, out)
+    return out
+
+
+@nb.njit(**_JIT)
 def rho_func(z):
     """ρ(z) = (e^z - 1 - z)/z², ρ(0) = 1/2."""
     if abs(z) < 0.05:

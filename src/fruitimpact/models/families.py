@@ -104,6 +104,10 @@ class ForceFamily:
         The dimensionless damping group on which alone e depends.
     to_group, from_group : callable
         (damping factor, m, k_c, v0) → group, and its inverse (group, m, k_c, v0) → factor.
+    damping_slot : int
+        Where the damping goes in the engine's parameter vector (stiffness, ·, ·).
+    damping_scaled : bool
+        The engine takes damping = factor × stiffness there (else the factor itself).
     elastic_stiffness : callable
         (m, k_c, v0) → the stiffness the force uses (k_c, or a matched linear k).
     """
@@ -121,7 +125,21 @@ class ForceFamily:
     group_doc: str
     to_group: Callable
     from_group: Callable
+    damping_slot: int = 1
+    damping_scaled: bool = False
     elastic_stiffness: Callable = _same_stiffness
+
+    def params(self, stiffness, damping_factor, exponent: float = 1.5) -> np.ndarray:
+        """Parameter matrix (rows, 3) of the engine's force (``engine.forces``): the stiffness,
+        then the damping in its slot (the power law keeps its exponent n in slot 1)."""
+        stiffness, damping_factor = np.broadcast_arrays(np.asarray(stiffness, dtype=float),
+                                                        np.asarray(damping_factor, dtype=float))
+        params = np.zeros(stiffness.shape + (3,))
+        params[..., 0] = stiffness
+        params[..., self.damping_slot] = damping_factor * stiffness if self.damping_scaled else damping_factor
+        if self.damping_slot == 2:
+            params[..., 1] = exponent
+        return params
 
     @property
     def units(self) -> tuple:
@@ -132,10 +150,12 @@ class ForceFamily:
 
 POWER_LAW = ForceFamily(
     forces.POWER_LAW, "power-law", "F = K δ^1.5 (1 + c δ̇)", "k_c", "N/m^1.5", "λ", "N·s/m^2.5", "s/m",
-    alpha=True, first_integral=True, group_doc="x = c V_i", to_group=_x_group, from_group=_x_factor)
+    alpha=True, first_integral=True, group_doc="x = c V_i", to_group=_x_group, from_group=_x_factor,
+    damping_slot=2)  # c [s/m]; slot 1 holds n
 KELVIN_VOIGT = ForceFamily(
     forces.KELVIN_VOIGT, "kelvin-voigt", "F = k δ + b δ̇", "k", "N/m", "b", "N·s/m", "s",
     alpha=False, first_integral=False, group_doc="ζ = b / (2 sqrt(k m))", to_group=_kv_group, from_group=_kv_factor,
+    damping_scaled=True,  # b = c k
     elastic_stiffness=hertz_equivalent_linear_stiffness)
 KUWABARA_KONO = ForceFamily(
     forces.KUWABARA_KONO, "kuwabara-kono", "F = K (δ^1.5 + B δ^0.5 δ̇)", "K", "N/m^1.5", "K·B", "N·s/m^1.5", "s",
@@ -144,7 +164,7 @@ KUWABARA_KONO = ForceFamily(
 TSUJI = ForceFamily(
     forces.TSUJI, "tsuji", "F = K δ^1.5 + η δ^0.25 δ̇", "K", "N/m^1.5", "η", "N·s/m^1.25", "s·m^0.25",
     alpha=False, first_integral=False, group_doc="α = η / sqrt(m K)",
-    to_group=_tsuji_group, from_group=_tsuji_factor)
+    to_group=_tsuji_group, from_group=_tsuji_factor, damping_scaled=True)  # η = c K
 
 #: Families by engine code.
 FAMILIES: dict[int, ForceFamily] = {f.code: f for f in (POWER_LAW, KELVIN_VOIGT, KUWABARA_KONO, TSUJI)}
