@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import contact
+from .contact import hertz_contact_duration
 from .calibrate import TABLE_E_MIN
 from .calibrate import damping_factor as calibrated_damping_factor
 from .constants import STANDARD_GRAVITY
@@ -110,13 +111,16 @@ def _check_ranges(inputs: InputColumns, messages: MessageBook, detail: bool) -> 
             if isinstance(name, str) and name in inputs.values and np.isnan(inputs.values[name][i]) \
                     and messages.text(i) == nan_message(INPUTS[name]):
                 messages.codes[i] = messages.code(f"{nan_message(INPUTS[name])}; got nan", name)
-    bad = inputs.given_matrix & ~inside(ALLOWED_BOUNDS, inputs.matrix)
-    for j in np.flatnonzero(bad.any(axis=1)):  # in table order: a row is refused for its first problem
+    which = inputs.given_inputs()
+    bad = inputs.given_matrix[which] & ~inside(ALLOWED_BOUNDS, inputs.matrix, which)
+    for row, j in enumerate(which):  # in table order: a row is refused for its first problem
+        if not bad[row].any():
+            continue
         name = NUMERIC_INPUTS[j]
         text = range_message(INPUTS[name])
         if detail:
             text += f"; got {float(inputs.matrix[j, 0])!r}"
-        messages.set(bad[j] & ~messages.flagged, text, name)
+        messages.set(bad[row] & ~messages.flagged, text, name)
     for group in ALTERNATIVES:
         count = np.sum([inputs.given[name] for name in group], axis=0)
         if np.any(count > 1):
@@ -135,10 +139,15 @@ def _check_text(inputs: InputColumns, messages: MessageBook) -> None:
 
 
 def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> None:
-    outside = inputs.given_matrix & np.isfinite(inputs.matrix) & ~inside(PLAUSIBLE_BOUNDS, inputs.matrix)
-    for j in np.flatnonzero(outside.any(axis=1)):
-        quantity = INPUTS[NUMERIC_INPUTS[j]]
-        warnings.add(outside[j], implausible_message(quantity, inputs.matrix[j, 0] if detail else None))
+    which = [j for j in inputs.given_inputs() if INPUTS[NUMERIC_INPUTS[j]].plausible is not None]
+    if not which:
+        return
+    outside = inputs.given_matrix[which] & np.isfinite(inputs.matrix[which]) & \
+        ~inside(PLAUSIBLE_BOUNDS, inputs.matrix, which)
+    for row, j in enumerate(which):
+        if outside[row].any():
+            quantity = INPUTS[NUMERIC_INPUTS[j]]
+            warnings.add(outside[row], implausible_message(quantity, inputs.matrix[j, 0] if detail else None))
 
 
 def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: bool | None = None,
@@ -147,8 +156,15 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
 
     ``detail`` (one row, the single-impact API) puts the offending value in messages;
     ``closed_forms`` adds the power-law first-integral self-check."""
+    # NaN and inf in refused rows propagate quietly: every row's outcome is judged explicitly
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        return _evaluate(inputs, messages, tabulated, detail, closed_forms)
+
+
+def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, closed_forms) -> Evaluation:
     rows = inputs.rows
     values, given = inputs.values, inputs.given
+    given_any = {name: bool(given[name].any()) for name in ("alpha", "damping")}
     warnings = WarningBook(rows)
     _check_ranges(inputs, messages, detail)
     codes = {name: inputs.text[name].codes for name in REGISTRIES}
@@ -158,14 +174,13 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
 
     used_matrix = np.where(inputs.given_matrix, inputs.matrix, NUMERIC_DEFAULTS)
     used = dict(zip(NUMERIC_INPUTS, used_matrix))
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
-        velocity = np.where(given["velocity"], values["velocity"],
-                            np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
-                                     GROUP_DEFAULTS["velocity"]))
-        radius = contact.effective_radius(used["diameter"] / 2.0, used["surface_radius"])
-        hertz = contact.hertz_stiffness(contact.effective_modulus(used["modulus"], used["poisson"],
-                                                                  used["surface_modulus"], used["surface_poisson"]),
-                                        radius)
+    velocity = np.where(given["velocity"], values["velocity"],
+                        np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
+                                 GROUP_DEFAULTS["velocity"]))
+    radius = contact.effective_radius(used["diameter"] / 2.0, used["surface_radius"])
+    hertz = contact.hertz_stiffness(contact.effective_modulus(used["modulus"], used["poisson"],
+                                                              used["surface_modulus"], used["surface_poisson"]),
+                                    radius)
     stiffness = np.where(given["stiffness"], values["stiffness"], hertz)
     damped_given = given["alpha"] | given["damping"]
     target = np.where(given["restitution"], values["restitution"],
@@ -180,46 +195,48 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
         law = DAMPING_LAWS.get(model) if isinstance(model, str) else None
         if law is None:
             continue
-        in_model = (model_codes == code) & ~messages.flagged
+        in_model = ~messages.flagged if len(uniques["model"]) == 1 else (model_codes == code) & ~messages.flagged
         family = law.force_family
-        if not family.alpha:
+        if not family.alpha and given_any["alpha"]:
             messages.set(in_model & given["alpha"],
                          f"alpha is Hunt–Crossley's damping parameter of the power-law laws; model {model} is "
                          f"{family.formula}: give restitution, or damping ({family.damping_symbol} "
                          f"[{family.damping_unit}])", "alpha")
             in_model &= ~messages.flagged
-        idx = np.flatnonzero(in_model)
+        idx, sel = _selection(in_model)
         if idx.size == 0:
             continue
-        m, k, v = mass[idx], stiffness[idx], velocity[idx]
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
-            k_law = np.asarray(law.linear_stiffness(m, k, v), dtype=float) * np.ones(idx.size)
-        law_stiffness[idx] = k_law
+        m, k, v = mass[sel], stiffness[sel], velocity[sel]
+        k_law = np.asarray(law.linear_stiffness(m, k, v), dtype=float) * np.ones(idx.size)
+        law_stiffness[sel] = k_law
         if law.undamped:
-            factor[idx] = 0.0
-            given_any = given["restitution"][idx] | damped_given[idx]
-            warnings.add(_mask(idx[given_any], rows), f"model {model} is undamped (e = 1): the restitution, "
-                                                      f"alpha or damping given is ignored")
+            factor[sel] = 0.0
+            given_some = given["restitution"][sel] | damped_given[sel]
+            warnings.add(_mask(idx[given_some], rows), f"model {model} is undamped (e = 1): the restitution, "
+                                                       f"alpha or damping given is ignored")
             continue
-        from_damping = given["damping"][idx]
-        from_alpha = given["alpha"][idx]
-        with np.errstate(invalid="ignore", divide="ignore"):
+        calibrate = np.ones(idx.size, dtype=bool)
+        if given_any["damping"]:
+            from_damping = given["damping"][sel]
             factor[idx[from_damping]] = values["damping"][idx[from_damping]] / k_law[from_damping]
-        factor[idx[from_alpha]] = 1.5 * values["alpha"][idx[from_alpha]]  # c = λ/k_c = 1.5 α (eq 5)
-        calibrate = ~(from_damping | from_alpha)
-        calibrations = codes["calibration"][idx]
+            calibrate &= ~from_damping
+        if given_any["alpha"]:
+            from_alpha = given["alpha"][sel]
+            factor[idx[from_alpha]] = 1.5 * values["alpha"][idx[from_alpha]]  # c = λ/k_c = 1.5 α (eq 5)
+            calibrate &= ~from_alpha
+        calibrations = codes["calibration"][sel]
         for cal_code, calibration in enumerate(uniques["calibration"]):
-            sub = calibrate & (calibrations == cal_code)
-            if sub.any():
-                rows_sub = idx[sub]
-                with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
-                    factor[rows_sub] = calibrated_damping_factor(law, calibration, target[rows_sub], mass[rows_sub],
-                                                                 stiffness[rows_sub], velocity[rows_sub])
-                if calibration == "exact" and not family.first_integral and not law.exact_by_construction:
-                    below = rows_sub[target[rows_sub] < TABLE_E_MIN]
-                    messages.set(_mask(below, rows), f"restitution must be >= {TABLE_E_MIN:g} for model {model} with "
-                                                     f"calibration exact (its table of e against the damping stops "
-                                                     f"there)", "restitution")
+            sub = calibrate if len(uniques["calibration"]) == 1 else calibrate & (calibrations == cal_code)
+            rows_sub, sub_sel = _selection(sub, idx, sel)
+            if rows_sub.size == 0:
+                continue
+            factor[sub_sel] = calibrated_damping_factor(law, calibration, target[sub_sel], mass[sub_sel],
+                                                        stiffness[sub_sel], velocity[sub_sel])
+            if calibration == "exact" and not family.first_integral and not law.exact_by_construction:
+                below = rows_sub[target[sub_sel] < TABLE_E_MIN]
+                messages.set(_mask(below, rows), f"restitution must be >= {TABLE_E_MIN:g} for model {model} with "
+                                                 f"calibration exact (its table of e against the damping stops "
+                                                 f"there)", "restitution")
 
     step = used["step"]
     rk4 = np.zeros(rows, dtype=bool)
@@ -237,28 +254,40 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
             messages.set(too_coarse, text, "step")
 
     status = np.full(rows, INVALID, dtype=np.int8)
-    out = np.full((rows, N_CHARACTERISTICS), np.nan)
+    out = None
     valid = ~messages.flagged
-    # inputs that are legal but whose scales leave double precision (V_i = 1e-160 m/s): failed, not computed
-    collapsed = valid & ~(np.isfinite(law_stiffness) & (law_stiffness > 0) & np.isfinite(factor)
-                          & (max_rk4_step(mass, stiffness, velocity) > 0))
-    status[collapsed] = FAILED
-    messages.set(collapsed, UNDERFLOW_MESSAGE)
-    valid &= ~collapsed
-    groups = codes["model"] * max(len(uniques["method"]), 1) + codes["method"]
-    for key in np.unique(groups[valid]):
-        model = uniques["model"][key // max(len(uniques["method"]), 1)]
-        solver = SOLVERS[uniques["method"][key % max(len(uniques["method"]), 1)]]
+    # inputs that are legal but whose law leaves double precision (Kelvin–Voigt at V_i = 1e-160 m/s): failed,
+    # not computed; impacts whose own scales underflow are caught by the judge (T = 0)
+    collapsed = valid & ~(np.isfinite(law_stiffness) & (law_stiffness > 0) & np.isfinite(factor))
+    if collapsed.any():
+        status[collapsed] = FAILED
+        messages.set(collapsed, UNDERFLOW_MESSAGE)
+        valid &= ~collapsed
+    methods = max(len(uniques["method"]), 1)
+    groups = codes["model"] * methods + codes["method"]
+    keys = [0] if len(uniques["model"]) == 1 and methods == 1 else np.unique(groups[valid])
+    for key in keys:
+        model = uniques["model"][key // methods]
+        solver = SOLVERS[uniques["method"][key % methods]]
         law = DAMPING_LAWS[model]
-        idx = np.flatnonzero(valid & (groups == key))
-        arguments = (law_stiffness[idx], factor[idx], mass[idx], velocity[idx], radius[idx], step[idx], tabulated)
+        idx, sel = _selection(valid if len(keys) == 1 else valid & (groups == key))
+        if idx.size == 0:
+            continue
+        arguments = (law_stiffness[sel], factor[sel], mass[sel], velocity[sel], radius[sel], step[sel], tabulated)
         group = solver.batch(law, *arguments)
         reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
-        judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference)
-        out[idx] = group
+        judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference,
+              time_scale=lambda some: hertz_contact_duration(mass[some], stiffness[some], velocity[some]))
+        if out is None and idx.size == rows:  # one group: its array is the output (no scatter)
+            out = group
+        else:
+            if out is None:
+                out = np.full((rows, N_CHARACTERISTICS), np.nan)
+            out[sel] = group
+    if out is None:
+        out = np.full((rows, N_CHARACTERISTICS), np.nan)
 
-    with np.errstate(invalid="ignore", divide="ignore"):
-        leaves_hertz = (status != INVALID) & (out[:, CONTACT_RADIUS] > HERTZ_RANGE * radius)
+    leaves_hertz = (status != INVALID) & (out[:, CONTACT_RADIUS] > HERTZ_RANGE * radius)
     if leaves_hertz.any():
         ratio = f" = {float(out[0, CONTACT_RADIUS] / radius[0]):.2g}" if detail else ""
         warnings.add(leaves_hertz, f"the contact radius leaves Hertz's range: a/R{ratio} > {HERTZ_RANGE:g} "
@@ -286,6 +315,17 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
                 closed[idx, 0], closed[idx, 1] = power_law_closed_forms(law_stiffness[idx], factor[idx], mass[idx],
                                                                         velocity[idx])
     return Evaluation(rows, columns, status, messages, warnings, closed)
+
+
+def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):
+    """(row numbers, a selector) of the True entries of ``mask``: the selector is ``slice(None)``
+    when that is every row, so that whole-table groups are views, not copies.  With ``idx``
+    and ``sel``, ``mask`` is over the rows ``idx`` already selected by ``sel``."""
+    if mask.all():
+        return (np.arange(mask.size) if idx is None else idx), (slice(None) if sel is None else sel)
+    positions = np.flatnonzero(mask)
+    rows = positions if idx is None else idx[positions]
+    return rows, rows
 
 
 def _mask(index: np.ndarray, size: int) -> np.ndarray:

@@ -64,6 +64,14 @@ class Fruit:
             if value is not None or item.name != "stiffness":
                 object.__setattr__(self, item.name, check_value(item.name, value))
 
+    @classmethod
+    def _checked(cls, **values) -> "Fruit":
+        """A Fruit of values that have just passed the same checks (no second validation)."""
+        fruit = object.__new__(cls)
+        for item in fields(cls):
+            object.__setattr__(fruit, item.name, values.get(item.name))
+        return fruit
+
     @property
     def radius(self) -> float:
         """Local radius of curvature at the contact, d/2 [m]."""
@@ -385,8 +393,8 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
     if STATUS_NAMES[code] == "invalid":
         raise InputError(messages.text(0), messages.argument(0))
     columns = {name: array[0] for name, array in result.columns.items()}  # Labels give the label
-    fruit_used = Fruit(**{name: columns[name] for name in ("mass", "diameter", "modulus", "poisson")},
-                       stiffness=row["stiffness"][0] if "stiffness" in row else None)
+    fruit_used = Fruit._checked(**{name: float(columns[name]) for name in ("mass", "diameter", "modulus", "poisson")},
+                                stiffness=row["stiffness"][0] if "stiffness" in row else None)
     surface_used = surface if surface is not None else RIGID_PLANE
     given = {name: (row[name][0] if name in row else None) for name in ("restitution", "alpha", "damping")}
     target = float(columns["target_restitution"])

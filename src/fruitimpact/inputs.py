@@ -75,6 +75,10 @@ class InputColumns:
     matrix: np.ndarray
     given_matrix: np.ndarray
 
+    def given_inputs(self) -> list[int]:
+        """Indices (in ``NUMERIC_INPUTS``) of the inputs given on at least one row."""
+        return np.flatnonzero(self.given_matrix.any(axis=1)).tolist()
+
 
 def _as_columns(table) -> dict:
     """Name → column of any supported container (pyarrow Table, DataFrame, mapping)."""
@@ -201,9 +205,6 @@ def _numeric(name: str, column, rows: int, messages: MessageBook) -> tuple[np.nd
             values[rows_text] = parsed[inverse]
             for j in np.flatnonzero(bad):
                 messages.set(_rows_mask(rows_text[inverse == j], rows), unreadable_message(quantity, str(unique[j])), name)
-    nan = given & np.isnan(values)
-    if nan.any():
-        messages.set(nan & ~messages.flagged, nan_message(quantity), name)
     return values, given
 
 
@@ -291,8 +292,17 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     values, given, text = {}, {}, {}
     for j, name in enumerate(NUMERIC_INPUTS):
         if name in by_key:
-            matrix[j], given_matrix[j] = _numeric(name, by_key[name], rows, messages)
+            column = by_key[name]
+            if isinstance(column, list) and all(type(c) is float or type(c) is int for c in column):
+                matrix[j] = column  # plain numbers (one impact from simulate, a list of floats)
+                given_matrix[j] = True
+            else:
+                matrix[j], given_matrix[j] = _numeric(name, column, rows, messages)
         values[name], given[name] = matrix[j], given_matrix[j]
+    nan = given_matrix & np.isnan(matrix)  # a NaN is a value: refused, never the default
+    if nan.any():
+        for j in np.flatnonzero(nan.any(axis=1)):
+            messages.set(nan[j] & ~messages.flagged, nan_message(INPUTS[NUMERIC_INPUTS[j]]), NUMERIC_INPUTS[j])
     for name in TEXT_INPUTS:
         text[name] = _text(name, by_key[name], rows) if name in by_key else \
             Labels.constant(INPUTS[name].default, rows)

@@ -39,7 +39,10 @@ class Range:
     high_inclusive: bool = False
 
     def contains(self, values):
-        """Boolean mask of ``values`` inside the interval (NaN is outside)."""
+        """Boolean mask of ``values`` inside the interval (NaN is outside); a bool for a float."""
+        if isinstance(values, float):
+            above = values >= self.low if self.low_inclusive else values > self.low
+            return above and (values <= self.high if self.high_inclusive else values < self.high)
         values = np.asarray(values, dtype=float)
         above = values >= self.low if self.low_inclusive else values > self.low  # NaN compares False: outside
         below = values <= self.high if self.high_inclusive else values < self.high
@@ -203,13 +206,23 @@ def _bounds(ranges) -> tuple[np.ndarray, ...]:
                  for field in ("low", "high", "low_inclusive", "high_inclusive"))
 
 
-def inside(bounds, matrix: np.ndarray) -> np.ndarray:
+def inside(bounds, matrix: np.ndarray, which=None) -> np.ndarray:
     """Mask of the entries of ``matrix`` (inputs × rows) inside each input's range of ``bounds``
-    (NaN is outside): every input checked in four whole-matrix operations."""
+    (NaN is outside).  ``which`` (indices of inputs) restricts the check to those inputs' rows
+    of the matrix; the result then has one row per index."""
     low, high, low_inclusive, high_inclusive = bounds
-    above = np.where(low_inclusive, matrix >= low, matrix > low)
-    below = np.where(high_inclusive, matrix <= high, matrix < high)
-    return above & below
+    if which is not None:
+        matrix = matrix[which]
+        low, high, low_inclusive, high_inclusive = low[which], high[which], low_inclusive[which], high_inclusive[which]
+    if matrix.size <= 4096:  # a few rows (one impact): four operations on the whole matrix
+        above = np.where(low_inclusive, matrix >= low, matrix > low)
+        return above & np.where(high_inclusive, matrix <= high, matrix < high)
+    out = np.empty(matrix.shape, dtype=bool)
+    for j in range(matrix.shape[0]):  # one comparison per bound: a whole row at a time
+        row = matrix[j]
+        above = row >= low[j, 0] if low_inclusive[j, 0] else row > low[j, 0]
+        np.logical_and(above, row <= high[j, 0] if high_inclusive[j, 0] else row < high[j, 0], out=out[j])
+    return out
 
 
 #: Bounds of the numeric inputs' allowed and plausible ranges, in ``NUMERIC_INPUTS`` order.

@@ -50,39 +50,38 @@ def _suggest_step(step, error, tolerance):
 
 
 def judge(values: np.ndarray, rows: np.ndarray, status: np.ndarray, messages: MessageBook, *, solver,
-          velocity: np.ndarray, step: np.ndarray, reference: np.ndarray | None = None) -> None:
+          velocity: np.ndarray, step: np.ndarray, reference: np.ndarray | None = None,
+          time_scale=None) -> None:
     """Judge the characteristics ``values`` (one row per entry of ``rows``, modified in place:
     a round-off excess of e over 1 is removed), setting ``status`` and ``messages`` of ``rows``.
 
     ``velocity`` and ``step`` are per row of the whole table; ``reference`` holds the accurate
-    solver's characteristics of the same rows when the solver is ``checked``."""
-    tolerance = solver.tolerance
-    finite = np.ones(rows.size, dtype=bool)
-    for column in ESSENTIAL:
-        finite &= np.isfinite(values[:, column])
-    e = values[:, RESTITUTION]
-    with np.errstate(invalid="ignore"):
-        collapsed = finite & ~((values[:, CONTACT_DURATION] > 0) & (values[:, MAX_DEFLECTION] > 0))
-        physical = finite & ~collapsed
-        energy_created = physical & (e > 1.0 + tolerance)
-        no_rebound = physical & ~(e > 0.0)
-        roundoff = physical & (e > 1.0) & ~energy_created
-    if roundoff.any():  # exactly elastic: report e = 1 and no absorbed energy
-        values[roundoff, RESTITUTION] = 1.0
-        values[roundoff, EXIT_VELOCITY] = velocity[rows[roundoff]]
-        values[roundoff, ABSORBED_ENERGY] = 0.0
+    solver's characteristics of the same rows when the solver is ``checked``; ``time_scale``
+    (rows → the undamped Hertz contact duration [s]) tells, for the rows without a result,
+    an impact whose scales leave double precision from a solver that did not finish."""
+    from .engine.checks import COLLAPSED, ENERGY_CREATED, NO_REBOUND, NOT_FINITE, classify
 
-    failed = ~finite | collapsed | energy_created | no_rebound
-    status[rows] = OK
-    if not failed.any():
+    outcome = classify(values, np.asarray(velocity[rows], dtype=float), solver.tolerance)
+    if not outcome.any():  # every row physical: the common case, settled in one pass
+        status[rows] = OK
         if solver.checked and reference is not None and rows.size:
             _check_against_reference(values, rows, reference, status, messages, solver, step)
         return
+    finite = outcome != NOT_FINITE
+    collapsed = outcome == COLLAPSED
+    energy_created = outcome == ENERGY_CREATED
+    no_rebound = outcome == NO_REBOUND
+    failed = ~finite | collapsed | energy_created | no_rebound
+    status[rows] = OK
     status[rows[failed]] = FAILED
     if solver.checked and reference is not None:
         # the reference tells a method error (a step too coarse) from an impossible impact
         for i in np.flatnonzero(failed):
             messages.set_row(rows[i], _checked_failure(solver, values[i], reference[i], step[rows[i]]))
+    if time_scale is not None and (~finite).any():
+        scale = np.asarray(time_scale(rows[~finite]), dtype=float)
+        lost = ~(np.isfinite(scale) & (scale >= np.finfo(float).tiny))
+        messages.set(_mask(rows[~finite][lost], status.size), UNDERFLOW_MESSAGE)
     messages.set(_mask(rows[~finite], status.size), "the solver did not reach separation (non-finite characteristics)")
     messages.set(_mask(rows[collapsed], status.size), UNDERFLOW_MESSAGE)
     for i in np.flatnonzero(energy_created | no_rebound):
