@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fruitimpact import Fruit, simulate
-from fruitimpact.calibrate import damping_factor, law_params
+from fruitimpact.calibrate import law_params
 from fruitimpact.comparison import restitution_table, unique_laws
 from fruitimpact.engine import forces
 from fruitimpact.models import DAMPING_LAWS, KUWABARA_KONO_C1

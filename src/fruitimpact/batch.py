@@ -65,6 +65,7 @@ class Evaluation:
     messages: MessageBook
     warnings: WarningBook
     closed_forms: np.ndarray | None = None
+    block: np.ndarray | None = None  # the characteristics as the engine wrote them (rows × 12)
 
     def labels(self) -> dict[str, Labels]:
         """``status``, ``message`` and ``warnings`` as ``Labels`` (no message on a row: its status)."""
@@ -314,7 +315,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             if law is not None and law.force_family.first_integral and idx.size:
                 closed[idx, 0], closed[idx, 1] = power_law_closed_forms(law_stiffness[idx], factor[idx], mass[idx],
                                                                         velocity[idx])
-    return Evaluation(rows, columns, status, messages, warnings, closed)
+    return Evaluation(rows, columns, status, messages, warnings, closed, out)
 
 
 def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):

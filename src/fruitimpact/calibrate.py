@@ -45,7 +45,6 @@ import math
 import numba as nb
 import numpy as np
 
-from .engine import codes
 from .engine.codes import RESTITUTION
 from .engine.powerlaw import exact_x
 

@@ -93,11 +93,12 @@ def _as_columns(table) -> dict:
 
 
 def _length(column) -> int | None:
-    if isinstance(column, (list, tuple)):
-        return len(column)
-    if isinstance(column, (str, bytes)) or np.ndim(column) == 0 and not hasattr(column, "__len__"):
+    """Rows of a column; None for a scalar (repeated on every row)."""
+    if isinstance(column, (str, bytes)):
         return None
-    return len(column)
+    if isinstance(column, np.ndarray):
+        return None if column.ndim == 0 else len(column)
+    return len(column) if hasattr(column, "__len__") else None
 
 
 def _is_arrow(column) -> bool:
@@ -227,7 +228,9 @@ def _text(name: str, column, rows: int) -> Labels:
     against their registry later).  Strings are stripped; numbers stay numbers (and are refused)."""
     default = INPUTS[name].default
     labels = None
-    if isinstance(column, list) and len(column) == 1:  # one impact (simulate)
+    if isinstance(column, Labels):  # already coded (a constant of a run, a factorized column)
+        labels = column
+    elif isinstance(column, list) and len(column) == 1:  # one impact (simulate)
         labels = Labels(np.zeros(1, dtype=np.int32), (column[0],))
     elif _is_arrow(column):
         import pyarrow as pa
@@ -239,8 +242,12 @@ def _text(name: str, column, rows: int) -> Labels:
             indices = encoded.indices.fill_null(len(encoded.dictionary))
             labels = Labels(np.asarray(indices.to_numpy(zero_copy_only=False), dtype=np.int32),
                             tuple(encoded.dictionary.to_pylist()) + (None,))
-    if labels is None:
-        cells, _ = _object_cells(column)
+        else:
+            labels = factorize(_object_cells(column)[0])
+    else:  # None, pd.NA and blanks become labels here, mapped to the default below
+        cells = column.to_numpy(dtype=object) if hasattr(column, "to_numpy") else np.asarray(column, dtype=object)
+        if cells.ndim != 1:
+            cells = _object_cells(column)[0]
         labels = factorize(cells)
     cleaned = []
     for label in labels.labels:
@@ -275,7 +282,7 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     lengths = {key: _length(columns[name]) for name, key in keys.items()}
     sized = {n for n in lengths.values() if n is not None}
     if len(sized) > 1:
-        raise ValueError(f"columns have different lengths: "
+        raise ValueError("columns have different lengths: "
                          + ", ".join(f"{k} {n}" for k, n in lengths.items() if n is not None))
     if rows is None:
         rows = sized.pop() if sized else (1 if columns else 0)
@@ -286,7 +293,8 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     by_key = {key: columns[name] for name, key in keys.items()}
     for key, length in lengths.items():
         if length is None:  # a scalar: the same on every row
-            by_key[key] = [by_key[key]] * rows
+            value = by_key[key]
+            by_key[key] = Labels.constant(value, rows) if key in TEXT_INPUTS else [value] * rows
     matrix = np.full((len(NUMERIC_INPUTS), rows), np.nan)
     given_matrix = np.zeros((len(NUMERIC_INPUTS), rows), dtype=bool)
     values, given, text = {}, {}, {}

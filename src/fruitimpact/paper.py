@@ -275,7 +275,6 @@ def write_paper_figures(directory) -> list[str]:
     """The worked example's four-panel figures (as stated, and at V_i = 0.8 m/s),
     overlaying the paper's RK4 grid, the accurate solution of the same λ = 1.5 α k_c
     (eq 5), and the accurate solution calibrated exactly to k = 1 − α V_i (eq 6)."""
-    from pathlib import Path
 
     from .outputs import check_output_folder
     from .plotting import impact_figure, save_figure

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .engine.codes import (ABSORBED_ENERGY, CONTACT_DURATION, EXIT_VELOCITY, MAX_DEFLECTION, PEAK_FORCE,
+from .engine.codes import (CONTACT_DURATION, MAX_DEFLECTION, PEAK_FORCE,
                               RESTITUTION)
 from .validation import MessageBook
 

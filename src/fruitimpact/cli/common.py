@@ -17,7 +17,7 @@ from ..quantities import INPUTS, option_of
 from ..units import parse_quantity
 from ..validation import conflict_message
 
-from . import PROG  # noqa: E402  (the package defines it before importing this module)
+from . import PROG  # noqa: E402,F401  (defined by the package first; the commands import it from here)
 
 
 class UsageError(Exception):

@@ -31,7 +31,7 @@ from ..plotting.runs import histogram_figure, sweep_figure
 from ..quantities import CHARACTERISTICS, DEFAULT_SUMMARY, INPUTS, Quantity
 from .chunks import evaluate_rows, run_chunk
 from .engines import ENGINES, DaskEngine, InProcessEngine
-from . import execute as execute_module
+from . import execute as execute_module  # noqa: F401  (the module, for tests that patch it)
 from .execute import default_workdir, execute, merge_parts, read_column
 from .plan import (BLOCK_ROWS, CHUNK_ROWS, MAX_AXIS_VALUES, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES,
                    SAMPLE_ROWS, Plan, RunError, Threshold, characteristic, characteristics_list)

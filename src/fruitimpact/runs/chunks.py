@@ -9,7 +9,6 @@ the files are in place.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -27,13 +26,6 @@ def evaluate_rows(inputs, start: int, errors=None):
     return evaluation(inputs, tabulated=True, errors=errors)
 
 
-def _moments(values: np.ndarray) -> tuple:
-    if values.size == 0:
-        return 0, 0.0, 0.0, math.inf, -math.inf
-    mean = float(values.mean())
-    return values.size, mean, float(np.sum((values - mean) ** 2)), float(values.min()), float(values.max())
-
-
 def summarise(plan, result, start: int) -> dict | None:
     """The summary arrays of a chunk of a population (None without statistics): moments
     (n, mean, M2, min, max) and threshold counts of the ok rows, and the rows kept in
@@ -41,18 +33,26 @@ def summarise(plan, result, start: int) -> dict | None:
     probability)."""
     if not plan.stats:
         return None
+    from ..engine.codes import COLUMN
+    from ..engine.moments import block_summary
+
     ok = result.status == 0
-    data = {name: np.asarray(result.columns[name], dtype=float)
-            for name in set(plan.stats) | {t.name for t in plan.thresholds}}
-    moments = []
-    for name in plan.stats:
-        values = data[name][ok]
-        moments.append(_moments(values[np.isfinite(values)]))
     probability = plan.sample_probability
     chosen = ok if probability >= 1.0 else ok & (plan.source.keys(start, start + result.rows) < probability)
+    names = list(plan.stats) + [t.name for t in plan.thresholds]
+    if all(name in COLUMN for name in names):  # characteristics only: one compiled pass over the block
+        moments, counts, sample = block_summary(
+            result.block, [COLUMN[name] for name in plan.stats], ok, chosen,
+            [(COLUMN[t.name], t.op, t.value) for t in plan.thresholds])
+        return {"moments": moments, "thresholds": counts, "sample": sample}
+    from ..engine.moments import column_moments
+
+    data = {name: np.asarray(result.columns[name], dtype=float) for name in set(names)}
+    moments = [column_moments(data[name], ok) for name in plan.stats]
+    every = bool(chosen.all())
     sample = np.empty((int(chosen.sum()), len(plan.stats)))
     for j, name in enumerate(plan.stats):
-        sample[:, j] = data[name][chosen]
+        sample[:, j] = data[name] if every else data[name][chosen]
     return {"moments": np.array(moments, dtype=float).reshape(len(plan.stats), 5),
             "thresholds": np.array([t.count(data[t.name][ok]) for t in plan.thresholds], dtype=np.int64),
             "sample": sample}

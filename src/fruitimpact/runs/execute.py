@@ -50,9 +50,14 @@ class TableWriter:
     def write(self, table) -> None:
         if self.writer is None:
             if self.format == "parquet":
+                import pyarrow as pa
                 import pyarrow.parquet as pq
 
-                self.writer = pq.ParquetWriter(self.path, table.schema, compression="snappy")
+                # dictionary encoding only where it pays (the text columns): tried on the float columns it
+                # makes writing twice as slow and the file no smaller
+                text = [f.name for f in table.schema if not pa.types.is_floating(f.type)
+                        and not pa.types.is_integer(f.type)]
+                self.writer = pq.ParquetWriter(self.path, table.schema, compression="snappy", use_dictionary=text)
             else:
                 import pyarrow.csv as pacsv
 

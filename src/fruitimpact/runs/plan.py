@@ -20,7 +20,7 @@ SAMPLE_ROWS = 2_000_000
 #: Default percentiles reported for populations [%].
 PERCENTILES = (5.0, 25.0, 50.0, 75.0, 95.0)
 #: Format version of the work folder (marker, manifest, part files, summaries).
-WORK_FORMAT = 2
+WORK_FORMAT = 3
 
 #: Most rows of one run (population members, grid points): about an hour of evaluation on a laptop.
 MAX_ROWS = 1_000_000_000

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..outputs import TABLE_FORMATS
+from ..labels import Labels
 from ..quantities import INPUTS
 from ..units import parse_quantity
 from .plan import BLOCK_ROWS, MAX_AXIS_VALUES, check_count
@@ -109,6 +110,12 @@ def _with_keys(table):
     return pa.Table.from_arrays(columns, names=names)
 
 
+def _stamp(path) -> tuple:
+    """What any write to a file changes: size, modification and change times [ns], inode."""
+    info = Path(path).stat()
+    return info.st_size, info.st_mtime_ns, info.st_ctime_ns, info.st_ino
+
+
 @dataclass(frozen=True)
 class TableSource:
     """Rows of a CSV or Parquet file, columns named like ``simulate``'s options.
@@ -124,6 +131,7 @@ class TableSource:
     size: int
     rows: int | None = None  # known for Parquet, counted while reading for CSV
     estimated_rows: int = 0
+    stamp: tuple = ()  # (size, mtime_ns, ctime_ns, inode) taken before the file was hashed
 
     @classmethod
     def open(cls, path) -> "TableSource":
@@ -142,7 +150,8 @@ class TableSource:
             check_columns(columns)
         except ValueError as exc:
             raise ValueError(f"input {str(path)!r}: {exc}") from None
-        size = Path(path).stat().st_size
+        stamp = _stamp(path)
+        size = stamp[0]
         if fmt == "csv":
             rows, estimated = None, _estimate_csv_rows(path, size)
         else:
@@ -150,14 +159,17 @@ class TableSource:
 
             rows = pq.ParquetFile(path).metadata.num_rows
             estimated = rows
-        return cls(str(Path(path).resolve()), fmt, columns, file_digest(path), size, rows, estimated)
+        return cls(str(Path(path).resolve()), fmt, columns, file_digest(path), size, rows, estimated, stamp)
 
     def identity(self) -> dict:
         return {"table": self.path, "sha256": self.digest, "bytes": self.size}
 
     def changed(self) -> bool:
-        """Whether the file now differs from what ``open`` hashed."""
+        """Whether the file now differs from what ``open`` hashed: unchanged if its size, times
+        and inode are those seen before hashing (any write changes them), else hashed again."""
         try:
+            if _stamp(self.path) == self.stamp:
+                return False
             return file_digest(self.path) != self.digest
         except OSError:
             return True
@@ -417,9 +429,9 @@ class PopulationSource:
             else:
                 columns[name] = self._stream(start, stop, stream_number(name), dist.draw)
         for name, value in self.text:
-            columns[name] = np.full(stop - start, value, dtype=object)
+            columns[name] = Labels.constant(value, stop - start)
         # with every input at its default there would be no column to carry the row count
-        columns.setdefault("model", np.full(stop - start, INPUTS["model"].default, dtype=object))
+        columns.setdefault("model", Labels.constant(INPUTS["model"].default, stop - start))
         return columns, None
 
     def keys(self, start: int, stop: int) -> np.ndarray:

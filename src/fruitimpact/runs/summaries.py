@@ -4,6 +4,7 @@ threshold counts and percentiles, merged from the chunks' summaries."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -60,11 +61,15 @@ def _merge_moments(moments: np.ndarray) -> tuple[int, float, float]:
 
 
 def _percentiles(column: np.ndarray, percentiles) -> dict:
-    """``numpy.percentile`` (linear) of the finite values of ``column``, one partition for all."""
-    column = column[np.isfinite(column)]
+    """``numpy.percentile`` (linear) of the finite values of ``column`` (a copy of its own, which
+    is partitioned in place: one partition for all percentiles, no further copy)."""
+    finite = np.isfinite(column)
+    if not finite.all():
+        column = column[finite]
     if not column.size:
         return {f"{p:g}": math.nan for p in percentiles}
-    return {f"{p:g}": float(v) for p, v in zip(percentiles, np.percentile(column, list(percentiles)))}
+    values = np.percentile(column, list(percentiles), overwrite_input=True)
+    return {f"{p:g}": float(v) for p, v in zip(percentiles, values)}
 
 
 def combine(summaries: list, plan, percentiles, ok: int) -> dict:
@@ -72,6 +77,12 @@ def combine(summaries: list, plan, percentiles, ok: int) -> dict:
     of the ``ok`` rows."""
     moments = np.stack([s["moments"] for s in summaries])  # chunks × stats × (n, mean, m2, min, max)
     sample = np.concatenate([s["sample"] for s in summaries]) if summaries else np.empty((0, len(plan.stats)))
+    # numpy's partition releases the GIL: the columns' percentiles in parallel threads
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=min(len(plan.stats), os.cpu_count() or 1) or 1) as pool:
+        quantiles = list(pool.map(lambda j: _percentiles(np.ascontiguousarray(sample[:, j]), percentiles),
+                                  range(len(plan.stats))))
     stats = {}
     for j, name in enumerate(plan.stats):
         n, mean, m2 = _merge_moments(moments[:, j])
@@ -80,7 +91,7 @@ def combine(summaries: list, plan, percentiles, ok: int) -> dict:
             "mean": mean if n else math.nan, "sd": math.sqrt(m2 / (n - 1)) if n > 1 else math.nan,
             "min": float(moments[:, j, 3].min()) if n else math.nan,
             "max": float(moments[:, j, 4].max()) if n else math.nan,
-            "percentiles": _percentiles(sample[:, j], percentiles),
+            "percentiles": quantiles[j],
         }
     threshold_counts = np.sum([s["thresholds"] for s in summaries], axis=0) if plan.thresholds else []
     thresholds = [{"threshold": t.text, "characteristic": t.name, "op": t.op, "value": t.value,

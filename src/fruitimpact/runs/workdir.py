@@ -17,7 +17,7 @@
   A part replaced, truncated or with flipped bytes is recomputed, never used.
 
 Part files are Arrow IPC files (no compression: writing and reading them costs
-little next to evaluation); summaries are NumPy ``.npz`` files.  Both are
+little next to evaluation); summaries are a stream of NumPy ``.npy`` records.  Both are
 written under a temporary name and renamed.  They are not fsync'ed: a power
 loss may cost a chunk, which the hash check then finds and recomputes.
 """
@@ -41,7 +41,7 @@ MARKER = ".fruitimpact-workdir"
 MANIFEST = "manifest.jsonl"
 LOCK = ".fruitimpact-lock"
 #: Files of a work folder that fruitimpact wrote: parts, summaries and their temporaries.
-_OWN = re.compile(r"^\.?part-\d{7}\.(arrow|summary\.npz)(\.fruitimpact-tmp-\d+-[0-9a-f]{8})?$")
+_OWN = re.compile(r"^\.?part-\d{7}\.(arrow|summary\.npy)(\.fruitimpact-tmp-\d+-[0-9a-f]{8})?$")
 
 
 def part_name(index: int) -> str:
@@ -49,7 +49,7 @@ def part_name(index: int) -> str:
 
 
 def summary_name(index: int) -> str:
-    return f"part-{index:07d}.summary.npz"
+    return f"part-{index:07d}.summary.npy"
 
 
 class _HashingFile:
@@ -104,10 +104,17 @@ def write_part(workdir, index: int, table) -> dict:
 
 
 def write_summary(workdir, index: int, arrays: dict) -> dict:
-    """Write chunk ``index``'s summary arrays as an .npz file; returns its file entry."""
-    buffer = io.BytesIO()  # a zip file needs to seek: built in memory, then written and hashed
-    np.savez(buffer, **arrays)
-    return _write_file(Path(workdir) / summary_name(index), lambda sink: sink.write(buffer.getbuffer()))
+    """Write chunk ``index``'s summary arrays into its summary file, hashed as written: the
+    arrays' names (one JSON line), then each array as a ``.npy`` record, in that order (a
+    stream: nothing is built in memory first)."""
+    names = list(arrays)
+
+    def write(sink):
+        sink.write((json.dumps(names) + "\n").encode())
+        for name in names:
+            np.lib.format.write_array(sink, np.asarray(arrays[name]), allow_pickle=False)
+
+    return _write_file(Path(workdir) / summary_name(index), write)
 
 
 def read_verified(workdir, entry: dict) -> bytes | None:
@@ -138,8 +145,9 @@ def read_summary(workdir, entry: dict) -> dict | None:
     data = read_verified(workdir, entry)
     if data is None:
         return None
-    with np.load(io.BytesIO(data)) as stored:
-        return {key: stored[key] for key in stored.files}
+    stream = io.BytesIO(data)
+    names = json.loads(stream.readline())
+    return {name: np.lib.format.read_array(stream, allow_pickle=False) for name in names}
 
 
 def _discard(path: Path) -> None:
