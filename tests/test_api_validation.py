@@ -139,9 +139,11 @@ def test_library_reads_units_like_the_cli():
 
 @pytest.mark.parametrize("call, message", [
     (lambda: fruitimpact.simulate(model=["chen"]), "model must be one of hertz, "),
-    (lambda: fruitimpact.simulate("apple"), "fruit must be a Fruit (or None for the paper's Jonathan apple); "
-                                            "got 'apple'"),
-    (lambda: fruitimpact.simulate(surface="steel"), "surface must be a Surface"),
+    (lambda: fruitimpact.simulate("banana"), "fruit must be one of jonathan-apple, apple, "),
+    (lambda: fruitimpact.simulate(fruit=3), "fruit must be a Fruit, a fruit of the library"),
+    (lambda: fruitimpact.simulate(surface="granite"), "surface must be one of rigid, steel, "),
+    (lambda: fruitimpact.simulate(surface=3), "surface must be a Surface, a surface of the library"),
+    (lambda: fruitimpact.simulate(velocty=2.0), "unknown input 'velocty'"),
     (lambda: fruitimpact.simulate(velocity=[1.0, 2.0]), "velocity must be a number"),
     (lambda: fruitimpact.simulate(method=None), "method must be one of accurate, rk4; got None"),
 ])

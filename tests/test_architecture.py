@@ -41,8 +41,16 @@ def test_every_input_of_the_table_is_a_batch_column():
     for name, quantity in INPUTS.items():
         value = quantity.default if quantity.default is not None else {
             "stiffness": 8e5, "velocity": 1.0, "drop_height": 0.1, "restitution": 0.5, "alpha": 0.1,
-            "damping": 1e5}[name]
-        result = evaluate({name: [value]})
+            "damping": 1e5, "bioyield_force": 20.0, "failure_stress": 3e5, "bruise_susceptibility": 4e-6,
+            "bruise_energy": 0.05}[name]
+        # bruise inputs mean something only with a criterion; a layer only with a finite thickness
+        extra = {"criterion": ["energy"]} if name in ("failure_stress", "bruise_susceptibility", "bruise_energy") \
+            else {"surface_thickness": [0.01], "surface_modulus": [1e6]} if name == "surface_model" else {}
+        if name == "surface_model":
+            value = "layer"
+        result = evaluate({name: [value], **extra} if name != "bruise_energy" else {name: [value], **extra})
+        if name in ("failure_stress", "bruise_susceptibility"):
+            result = evaluate({name: [value], "criterion": ["pressure"]})
         assert result.loc[0, "status"] == "ok", (name, result.loc[0, "message"])
 
 

@@ -35,6 +35,22 @@ KNOWN = [
     ("5N/m^2", "modulus", 5.0),
     ("3N/mm2", "modulus", 3e6),
     ("3N/mm^2", "modulus", 3e6),
+    # bruise susceptibility [m³/J]: 1 cm³ = 1 ml = 1e-6 m³, 1 mm³ = 1e-9 m³
+    ("2e-6m3/J", "susceptibility", 2e-6),
+    ("2e-6m^3/J", "susceptibility", 2e-6),
+    ("4.66cm3/J", "susceptibility", 4.66e-6),
+    ("4.66cm^3/J", "susceptibility", 4.66e-6),
+    ("3ml/J", "susceptibility", 3e-6),
+    ("500mm3/J", "susceptibility", 5e-7),
+    ("500mm^3/J", "susceptibility", 5e-7),
+    # volume [m³]
+    ("1e-6m3", "volume", 1e-6),
+    ("1e-6m^3", "volume", 1e-6),
+    ("2cm3", "volume", 2e-6),
+    ("2cm^3", "volume", 2e-6),
+    ("2ml", "volume", 2e-6),
+    ("500mm3", "volume", 5e-7),
+    ("500mm^3", "volume", 5e-7),
     # velocity [m/s]
     ("1m/s", "velocity", 1.0),
     ("150cm/s", "velocity", 1.5),

@@ -26,12 +26,15 @@ from .contact import hertz_contact_duration
 from .calibrate import TABLE_E_MIN
 from .calibrate import damping_factor as calibrated_damping_factor
 from .constants import STANDARD_GRAVITY
-from .engine.powerlaw import CHARACTERISTIC_COLUMNS, CONTACT_RADIUS, N_CHARACTERISTICS
+from .engine.powerlaw import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
 from .inputs import InputColumns, read_columns
 from .models import DAMPING_LAWS
 from .registries import REGISTRIES
-from .quantities import (ALLOWED_BOUNDS, ALTERNATIVES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS, NUMERIC_INPUTS,
-                         PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
+from . import presets
+from .damage.assess import CRITERION_NAMES, bruise_columns
+from .engine.plastic import PLASTIC_COLUMNS, plastic_characteristics, winkler_stiffness, yield_pressure_of_force
+from .quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
+                         NUMERIC_INPUTS, PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
 from .solvers import SOLVERS, max_rk4_step, power_law_closed_forms
 from .status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from .labels import Labels
@@ -42,7 +45,11 @@ from .validation import (MessageBook, WarningBook, conflict_message, implausible
 #: ``damping``, given or calibrated).
 INPUT_OUTPUTS = tuple(name for name in NUMERIC_INPUTS if name not in ("restitution", "damping")) + TEXT_INPUTS
 LAW_COLUMNS = ("target_restitution", "law_stiffness", "damping", "damping_factor")
-OUTPUT_COLUMNS = INPUT_OUTPUTS + LAW_COLUMNS + CHARACTERISTIC_COLUMNS + ("status", "message", "warnings")
+OUTPUT_COLUMNS = INPUT_OUTPUTS + LAW_COLUMNS + CHARACTERISTIC_COLUMNS + DAMAGE_NAMES + ("status", "message", "warnings")
+#: Thinnest cushion the layer model takes [m]: below it the pad is a coating (use a half-space).
+MIN_LAYER_THICKNESS = 0.5e-3
+#: Bruise inputs that mean nothing without a criterion.
+BRUISE_INPUTS = ("failure_stress", "bruise_susceptibility", "bruise_energy")
 #: Contact radius / effective radius beyond which Hertz's theory is left: the paraboloid that
 #: replaces the sphere in Hertz's solution is then more than (a/R)²/4 = 4 % off at the contact edge.
 HERTZ_RANGE = 0.4
@@ -66,6 +73,8 @@ class Evaluation:
     warnings: WarningBook
     closed_forms: np.ndarray | None = None
     block: np.ndarray | None = None  # the characteristics as the engine wrote them (rows × 12)
+    plastic: np.ndarray | None = None  # rows computed by the plastic engine (yield pressure or a layer)
+    kernel_arguments: dict | None = None  # those rows' arguments of engine.plastic (for their curves)
 
     def labels(self) -> dict[str, Labels]:
         """``status``, ``message`` and ``warnings`` as ``Labels`` (no message on a row: its status)."""
@@ -175,19 +184,38 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
 
     used_matrix = np.where(inputs.given_matrix, inputs.matrix, NUMERIC_DEFAULTS)
     used = dict(zip(NUMERIC_INPUTS, used_matrix))
+    resolved = presets.resolve(inputs, GROUP_DEFAULTS["restitution"])
+    resolved.apply(used, given)
     velocity = np.where(given["velocity"], values["velocity"],
                         np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
                                  GROUP_DEFAULTS["velocity"]))
     radius = contact.effective_radius(used["diameter"] / 2.0, used["surface_radius"])
-    hertz = contact.hertz_stiffness(contact.effective_modulus(used["modulus"], used["poisson"],
-                                                              used["surface_modulus"], used["surface_poisson"]),
-                                    radius)
+    layer = resolved.surface_model == presets.LAYER
+    any_layer = bool(layer.any())
+    fruit_modulus = contact.effective_modulus(used["modulus"], used["poisson"])
+    # on a layer the fruit's own contact is with the (rigid) substrate; the layer is a spring in series
+    pair_modulus = contact.effective_modulus(used["modulus"], used["poisson"], used["surface_modulus"],
+                                             used["surface_poisson"])
+    contact_modulus = np.where(layer, fruit_modulus, pair_modulus) if any_layer else pair_modulus
+    hertz = contact.hertz_stiffness(contact_modulus, radius)
     stiffness = np.where(given["stiffness"], values["stiffness"], hertz)
+    if given["stiffness"].any():  # the modulus that goes with a given k_c (Thornton needs E*)
+        contact_modulus = np.where(given["stiffness"], 0.75 * stiffness / np.sqrt(radius), contact_modulus)
     damped_given = given["alpha"] | given["damping"]
     target = np.where(given["restitution"], values["restitution"],
-                      np.where(damped_given, np.nan, GROUP_DEFAULTS["restitution"]))
+                      np.where(damped_given, np.nan, resolved.restitution))
     used["velocity"], used["stiffness"] = velocity, stiffness
-    mass = used["mass"]
+    # a free partner (another fruit): the reduced mass moves at the approach speed
+    mass = presets.effective_mass(used["mass"], used["partner_mass"])
+    yield_pressure = np.where(given["bioyield_force"],
+                              yield_pressure_of_force(contact_modulus, radius, used["bioyield_force"]),
+                              used["yield_pressure"])
+    thickness = np.where(layer, used["surface_thickness"], np.inf) if any_layer else np.full(rows, np.inf)
+    layer_stiffness = np.where(layer, winkler_stiffness(used["surface_modulus"], used["surface_poisson"],
+                                                        thickness, radius), np.inf) if any_layer \
+        else np.full(rows, np.inf)
+    plastic = np.isfinite(yield_pressure) | layer
+    _check_damage_inputs(inputs, resolved, layer, used, thickness, messages)
 
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
@@ -203,6 +231,13 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                          f"alpha is Hunt–Crossley's damping parameter of the power-law laws; model {model} is "
                          f"{family.formula}: give restitution, or damping ({family.damping_symbol} "
                          f"[{family.damping_unit}])", "alpha")
+            in_model &= ~messages.flagged
+        if not family.first_integral and plastic.any():
+            messages.set(in_model & plastic,
+                         f"plastic contact (--yield-pressure, --bioyield-force) and cushion layers are built on the "
+                         f"power-law family F = F_T(δ)(1 + c δ̇); model {model} is {family.formula}: use hertz "
+                         f"(pure Thornton) or a power-law damping law (hunt-crossley, ...)",
+                         "yield_pressure" if not layer.any() else "surface_model")
             in_model &= ~messages.flagged
         idx, sel = _selection(in_model)
         if idx.size == 0:
@@ -244,6 +279,10 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     for code, method in enumerate(uniques["method"]):
         if method == "rk4":
             rk4 |= codes["method"] == code
+    if rk4.any() and plastic.any():
+        messages.set(rk4 & plastic & ~messages.flagged,
+                     "method rk4 integrates the paper's elastic laws only: plastic contact and cushion layers are "
+                     "computed exactly (method accurate)", "method")
     if rk4.any():
         limit = max_rk4_step(mass, stiffness, velocity)
         too_coarse = rk4 & ~messages.flagged & ~(step <= limit)
@@ -256,6 +295,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
 
     status = np.full(rows, INVALID, dtype=np.int8)
     out = None
+    plastic_block = None
     valid = ~messages.flagged
     # inputs that are legal but whose law leaves double precision (Kelvin–Voigt at V_i = 1e-160 m/s): failed,
     # not computed; impacts whose own scales underflow are caught by the judge (T = 0)
@@ -274,9 +314,28 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
         idx, sel = _selection(valid if len(keys) == 1 else valid & (groups == key))
         if idx.size == 0:
             continue
-        arguments = (law_stiffness[sel], factor[sel], mass[sel], velocity[sel], radius[sel], step[sel], tabulated)
-        group = solver.batch(law, *arguments)
-        reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
+        group_plastic = plastic[idx]
+        if group_plastic.any():  # elastic-plastic or layered rows: the plastic engine
+            elastic_rows = idx[~group_plastic]
+            plastic_rows = idx[group_plastic]
+            group = np.empty((idx.size, N_CHARACTERISTICS))
+            if plastic_block is None:
+                plastic_block = np.full((rows, len(PLASTIC_COLUMNS)), np.nan)
+            group[group_plastic], plastic_block[plastic_rows] = plastic_characteristics(
+                mass[plastic_rows], velocity[plastic_rows], stiffness[plastic_rows], radius[plastic_rows],
+                contact_modulus[plastic_rows], yield_pressure[plastic_rows], layer_stiffness[plastic_rows],
+                thickness[plastic_rows], factor[plastic_rows])
+            if elastic_rows.size:
+                group[~group_plastic] = solver.batch(law, law_stiffness[elastic_rows], factor[elastic_rows],
+                                                     mass[elastic_rows], velocity[elastic_rows],
+                                                     radius[elastic_rows], step[elastic_rows], tabulated)
+            reference = None  # rk4 is refused for these rows
+            sel = idx
+        else:
+            arguments = (law_stiffness[sel], factor[sel], mass[sel], velocity[sel], radius[sel], step[sel],
+                         tabulated)
+            group = solver.batch(law, *arguments)
+            reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
         judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference,
               time_scale=lambda some: hertz_contact_duration(mass[some], stiffness[some], velocity[some]))
         if out is None and idx.size == rows:  # one group: its array is the output (no scatter)
@@ -295,7 +354,13 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                    f"(δ_max/R > {HERTZ_RANGE ** 2:g}), where the paraboloid that Hertz puts in "
                                    f"place of the fruit is more than 4 % off; treat the figures as an estimate")
 
+    done = status != INVALID
+    _range_warnings(warnings, out, plastic_block, layer, thickness, used["surface_thickness"], radius, done, detail)
+    damage = _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, fruit_modulus, pair_modulus,
+                             layer, resolved)
     columns = {name: used[name] for name in NUMERIC_INPUTS if name in INPUT_OUTPUTS}
+    columns["yield_pressure"] = yield_pressure
+    columns.update(damage)
     columns["drop_height"] = np.where(given["drop_height"], values["drop_height"], np.nan)
     columns["alpha"] = np.where(given["alpha"], values["alpha"], np.nan)
     for name in TEXT_INPUTS:
@@ -311,11 +376,102 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
         closed = np.full((rows, 2), np.nan)
         for code, model in enumerate(uniques["model"]):
             law = DAMPING_LAWS.get(model) if isinstance(model, str) else None
-            idx = np.flatnonzero((model_codes == code) & (status != INVALID))
+            idx = np.flatnonzero((model_codes == code) & (status != INVALID) & ~plastic)
             if law is not None and law.force_family.first_integral and idx.size:
                 closed[idx, 0], closed[idx, 1] = power_law_closed_forms(law_stiffness[idx], factor[idx], mass[idx],
                                                                         velocity[idx])
-    return Evaluation(rows, columns, status, messages, warnings, closed, out)
+    arguments = dict(mass=mass, velocity=velocity, stiffness=stiffness, radius=radius,
+                     contact_modulus=contact_modulus, yield_pressure=yield_pressure, layer_stiffness=layer_stiffness,
+                     thickness=thickness, damping_factor=factor)
+    return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments)
+
+
+def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness, messages: MessageBook) -> None:
+    """Refusals that need the presets: layers without a usable thickness, bruise inputs without a
+    criterion, an energy criterion without a threshold."""
+    given = inputs.given
+    if layer.any():
+        no_thickness = layer & ~np.isfinite(thickness)
+        messages.set(no_thickness & ~messages.flagged,
+                     "surface_thickness must be given (finite) for a layer surface: the elastic-foundation model "
+                     "is a cushion of thickness h on a rigid substrate", "surface_thickness")
+        thin = layer & (thickness < MIN_LAYER_THICKNESS)
+        messages.set(thin & ~messages.flagged,
+                     f"surface_thickness must be >= {MIN_LAYER_THICKNESS * 1e3:g} mm for a layer surface (a thinner "
+                     f"pad is a coating: use --surface-model half-space or a rigid surface)", "surface_thickness")
+        rigid = layer & ~np.isfinite(used["surface_modulus"])
+        messages.set(rigid & ~messages.flagged, "surface_modulus must be finite for a layer surface",
+                     "surface_modulus")
+    criteria = inputs.text["criterion"]
+    for code, name in enumerate(criteria.labels):
+        where = criteria.codes == code
+        if name == "none":
+            for key in BRUISE_INPUTS:
+                if given[key].any():
+                    messages.set(where & given[key] & ~messages.flagged,
+                                 f"{key} is a bruise input: give --criterion pressure, shear or energy with it "
+                                 f"(the criterion changes the onset height by an order of magnitude)", key)
+        elif name == "energy":
+            messages.set(where & resolved.no_threshold & ~given["bruise_energy"] & ~messages.flagged,
+                         "bruise_energy must be given for the energy criterion (the absorbed energy at bruise onset "
+                         "[J]; the --fruit's library entry has none)", "bruise_energy")
+        elif name == "shear":
+            poisson = used["poisson"]
+            messages.set(where & ~((poisson >= 0.0) & (poisson <= 0.5)) & ~messages.flagged,
+                         "poisson must be in [0, 0.5] for the shear criterion (Hertz's subsurface field)", "poisson")
+
+
+def _range_warnings(warnings: WarningBook, out, plastic_block, layer, thickness, given_thickness, radius, done,
+                    detail: bool) -> None:
+    """Warnings where a surface model is used outside its range."""
+    if out is None:
+        return
+    a = out[:, CONTACT_RADIUS]
+    if layer.any():
+        thick = done & layer & (a < thickness)
+        if thick.any():
+            ratio = f" ({float(a[0]) * 1e3:.3g} mm < {float(thickness[0]) * 1e3:.3g} mm)" if detail else ""
+            warnings.add(thick, f"the contact radius is smaller than the layer thickness{ratio}: the "
+                                f"elastic-foundation model assumes a thin layer (a >= h); treat the figures as an "
+                                f"estimate")
+        if plastic_block is not None:
+            bottomed = done & layer & (plastic_block[:, PLASTIC_COLUMNS.index("bottomed_out")] == 1.0)
+            if bottomed.any():
+                warnings.add(bottomed, "the pad bottoms out: its deflection reaches its thickness, and the force "
+                                       "beyond that is carried by the substrate as if rigid")
+    half_space_layer = done & ~layer & np.isfinite(given_thickness) & (a > given_thickness)
+    if half_space_layer.any():
+        warnings.add(half_space_layer, "the contact radius exceeds the surface thickness: Hertz's half-space does not "
+                                       "hold; use --surface-model layer")
+
+
+def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, fruit_modulus, pair_modulus, layer,
+                    resolved) -> dict:
+    """The damage outputs (``quantities.DAMAGE_NAMES``) of every row."""
+    rows = done.size
+    if out is None:
+        out = np.full((rows, N_CHARACTERISTICS), np.nan)
+    absorbed = out[:, COLUMN["absorbed_energy"]]
+    columns = {"yield_velocity": np.full(rows, np.inf), "permanent_deflection": np.zeros(rows),
+               "plastic_work": np.zeros(rows), "viscous_work": absorbed.copy()}
+    share = (1.0 / fruit_modulus) / (1.0 / pair_modulus)  # the fruit's share of the compliance
+    if plastic_block is not None:
+        computed = ~np.isnan(plastic_block[:, 0])
+        for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
+            columns[name] = np.where(computed, plastic_block[:, PLASTIC_COLUMNS.index(name)], columns[name])
+        share = np.where(computed & layer, plastic_block[:, PLASTIC_COLUMNS.index("fruit_work_share")], share)
+    for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
+        columns[name] = np.where(done, columns[name], np.nan)
+    columns["fruit_energy"] = np.where(done, absorbed * share, np.nan)
+    criterion = inputs.text["criterion"]
+    codes = np.asarray([CRITERION_NAMES.index(label) if label in CRITERION_NAMES else 0
+                        for label in criterion.labels], dtype=np.int8)[criterion.codes] \
+        if len(criterion.labels) else np.zeros(rows, dtype=np.int8)
+    columns.update(bruise_columns(codes, peak_pressure=out[:, COLUMN["max_pressure"]], poisson=used["poisson"],
+                                  fruit_energy=columns["fruit_energy"], failure_stress=used["failure_stress"],
+                                  threshold_energy=used["bruise_energy"], susceptibility=used["bruise_susceptibility"],
+                                  contact_radius=out[:, CONTACT_RADIUS], valid=done))
+    return {name: columns[name] for name in DAMAGE_NAMES}
 
 
 def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):

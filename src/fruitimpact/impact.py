@@ -90,15 +90,28 @@ class Surface:
         Poisson's ratio [-].
     radius : float
         Radius of curvature [m]; ``inf`` is a plane.
+    thickness : float
+        Thickness h [m] of a cushion on a rigid substrate (``inf``: a half-space); with
+        ``surface_model="layer"`` the elastic-foundation model of ``engine.plastic``.
     """
 
     modulus: float = INPUTS["surface_modulus"].default
     poisson: float = INPUTS["surface_poisson"].default
     radius: float = INPUTS["surface_radius"].default
+    thickness: float = INPUTS["surface_thickness"].default
 
     def __post_init__(self):
         for item in fields(self):
             object.__setattr__(self, item.name, check_value("surface_" + item.name, getattr(self, item.name)))
+
+
+    @classmethod
+    def _checked(cls, **values) -> "Surface":
+        """A Surface of values that have just passed the same checks (no second validation)."""
+        surface = object.__new__(cls)
+        for item in fields(cls):
+            object.__setattr__(surface, item.name, values.get(item.name))
+        return surface
 
 
 RIGID_PLANE = Surface()
@@ -246,6 +259,11 @@ class ImpactResult:
     message: str = "ok"
     warnings: tuple = ()
     curve_points: int = field(default=1001, repr=False)
+    damage: dict = field(default_factory=dict)
+    names: dict = field(default_factory=dict)
+    damage_inputs: dict = field(default_factory=dict)
+    plastic: bool = False
+    plastic_arguments: dict = field(default_factory=dict, repr=False)
 
     @property
     def success(self) -> bool:
@@ -260,6 +278,10 @@ class ImpactResult:
 
         if not math.isfinite(self.characteristics.contact_duration):
             raise ValueError(f"no curves: the impact {self.status} ({self.message})")
+        if self.plastic:  # elastic-plastic or layered: the plastic engine's own curves
+            from .engine.plastic import plastic_curves
+
+            return Curves(*plastic_curves(self.curve_points, **self.plastic_arguments))
         solver = get_solver(self.inputs.method)
         law = get_law(self.inputs.model)
         return Curves(*solver.samples(law, self.law.stiffness, self.law.damping_factor, self.inputs.fruit.mass,
@@ -285,6 +307,9 @@ class ImpactResult:
             step=inputs.step,
             success=self.success, status=self.status, message=self.message, warnings=list(self.warnings),
         )
+        flat.update(self.damage)
+        flat.update(self.damage_inputs)
+        flat.update(self.names)
         flat["inputs"] = {"fruit": fruit, "surface": asdict(inputs.surface),
                           "velocity": inputs.velocity, "drop_height": inputs.drop_height,
                           "restitution": inputs.restitution, "alpha": inputs.alpha, "damping": inputs.damping,
@@ -311,20 +336,28 @@ def resolve_stiffness(fruit: Fruit, surface: Surface = RIGID_PLANE) -> tuple[flo
 
 
 def _row(fruit, surface, keywords: dict) -> dict:
-    """The one-row table of a ``simulate`` call, every value checked to be a single value."""
-    if fruit is None:
-        fruit = Fruit()
-    elif not isinstance(fruit, Fruit):
-        raise InputError(f"fruit must be a Fruit (or None for the paper's Jonathan apple); got {fruit!r}", "fruit")
-    if surface is None:
-        surface = RIGID_PLANE
-    elif not isinstance(surface, Surface):
-        raise InputError(f"surface must be a Surface (or None for a rigid plane); got {surface!r}", "surface")
-    row = {name: [value] for name, value in asdict(fruit).items() if value is not None}
-    row.update({"surface_" + name: [value] for name, value in asdict(surface).items()})
+    """The one-row table of a ``simulate`` call, every value checked to be a single value.
+    ``fruit`` and ``surface`` are objects (their fields are inputs) or library names."""
+    row = {}
+    if isinstance(fruit, str):
+        keywords = {"fruit": fruit, **keywords}
+    elif isinstance(fruit, Fruit):
+        row.update({name: [value] for name, value in asdict(fruit).items() if value is not None})
+    elif fruit is not None:
+        raise InputError(f"fruit must be a Fruit, a fruit of the library (fruitimpact fruits) or None for the "
+                         f"paper's Jonathan apple; got {fruit!r}", "fruit")
+    if isinstance(surface, str):
+        keywords = {"surface": surface, **keywords}
+    elif isinstance(surface, Surface):
+        row.update({"surface_" + name: [value] for name, value in asdict(surface).items()})
+    elif surface is not None:
+        raise InputError(f"surface must be a Surface, a surface of the library (fruitimpact surfaces) or None for "
+                         f"a rigid plane; got {surface!r}", "surface")
     from .registries import REGISTRIES
 
     for name, value in keywords.items():
+        if name not in INPUTS:
+            raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
         if name in REGISTRIES:
             row[name] = [check_choice(name, value, REGISTRIES[name])]
         elif value is not None:
@@ -332,17 +365,19 @@ def _row(fruit, surface, keywords: dict) -> dict:
     return row
 
 
-def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, restitution=None,
+def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=None, restitution=None,
              alpha=None, damping=None, model: str = INPUTS["model"].default,
              calibration: str = INPUTS["calibration"].default, method: str = INPUTS["method"].default,
-             step=INPUTS["step"].default, surface: Surface | None = None,
-             curve_points: int = 1001) -> ImpactResult:
+             step=INPUTS["step"].default, surface: Surface | str | None = None,
+             curve_points: int = 1001, **inputs) -> ImpactResult:
     """Simulate one impact of ``fruit`` on ``surface``.
 
     Parameters
     ----------
-    fruit : Fruit, optional
-        Default: the paper's Jonathan apple (``constants.JONATHAN_SOURCE``).
+    fruit : Fruit or str, optional
+        A Fruit, or the name of a fruit of the library (``library.fruits()``: its
+        properties, each overridden by a keyword of ``inputs``); default: the paper's
+        Jonathan apple (``constants.JONATHAN_SOURCE``).
     velocity : float, optional
         Impact velocity V_i [m/s]; default 1 m/s.
     drop_height : float, optional
@@ -367,10 +402,18 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
         fixed-step integration at ``step`` [s], checked against ``accurate``).
     step : float
         RK4 time step [s] (default 1e-4 s, the paper's).
-    surface : Surface, optional
-        Default rigid plane.
+    surface : Surface or str, optional
+        A Surface, or the name of a surface of the library (``library.surfaces()``;
+        ``"fruit"``: an identical free fruit, ``velocity`` then being the approach
+        speed); default a rigid plane.
     curve_points : int
         Samples of the ``accurate`` curves over [0, T].
+    **inputs
+        Any other input of ``quantities.INPUTS`` by name, e.g. the damage inputs
+        ``yield_pressure`` [Pa] (Thornton's p_y), ``bioyield_force`` [N],
+        ``failure_stress`` [Pa], ``criterion`` (``pressure``, ``shear``, ``energy``),
+        ``bruise_susceptibility`` [m³/J], ``bruise_energy`` [J], ``partner_mass`` [kg],
+        ``surface_model``, or the fruit's ``mass``, ``diameter`` … without a Fruit.
 
     Numbers may be given as strings with units (``velocity="2 m/s"``).
 
@@ -385,7 +428,7 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
     from .inputs import read_columns
 
     keywords = dict(velocity=velocity, drop_height=drop_height, restitution=restitution, alpha=alpha,
-                    damping=damping, model=model, calibration=calibration, method=method, step=step)
+                    damping=damping, model=model, calibration=calibration, method=method, step=step, **inputs)
     row = _row(fruit, surface, keywords)
     inputs, messages = read_columns(row)
     result = evaluate_inputs(inputs, messages, detail=True, closed_forms=True)
@@ -395,7 +438,8 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
     columns = {name: array[0] for name, array in result.columns.items()}  # Labels give the label
     fruit_used = Fruit._checked(**{name: float(columns[name]) for name in ("mass", "diameter", "modulus", "poisson")},
                                 stiffness=row["stiffness"][0] if "stiffness" in row else None)
-    surface_used = surface if surface is not None else RIGID_PLANE
+    surface_used = Surface._checked(**{name: float(columns["surface_" + name])
+                                       for name in ("modulus", "poisson", "radius", "thickness")})
     given = {name: (row[name][0] if name in row else None) for name in ("restitution", "alpha", "damping")}
     target = float(columns["target_restitution"])
     inputs_used = ImpactInputs(fruit=fruit_used, surface=surface_used, velocity=float(columns["velocity"]),
@@ -415,6 +459,17 @@ def simulate(fruit: Fruit | None = None, *, velocity=None, drop_height=None, res
                                       max_deflection_closed_form=float(result.closed_forms[0, 0]),
                                       restitution_closed_form=float(result.closed_forms[0, 1]))
     message = messages.text(0) or "ok"
+    from .quantities import DAMAGE_NAMES
+
+    damage = {name: float(columns[name]) for name in DAMAGE_NAMES}
+    damage["bruised"] = None if math.isnan(damage["bruised"]) else bool(damage["bruised"])
+    names = {name: columns[name] for name in ("fruit", "surface", "surface_model", "criterion")}
+    damage_inputs = {name: float(columns[name]) for name in
+                     ("yield_pressure", "surface_thickness", "partner_mass", "failure_stress", "bruise_susceptibility",
+                      "bruise_energy")}
     return ImpactResult(inputs=inputs_used, law=contact_law, characteristics=characteristics,
                         status=STATUS_NAMES[code], message=message, warnings=tuple(result.warnings.row(0)),
-                        curve_points=curve_points)
+                        curve_points=curve_points, damage=damage, names=names, damage_inputs=damage_inputs,
+                        plastic=bool(result.plastic[0]),
+                        plastic_arguments={name: float(np.asarray(value)[0]) if np.ndim(value) else float(value)
+                                           for name, value in result.kernel_arguments.items()})

@@ -178,6 +178,33 @@ INPUTS: dict[str, Quantity] = _table(
     Quantity("surface_radius", "R_2", "surface radius R_2", "length", "mm", 1e3,
              "radius of curvature of the surface (default inf: flat)",
              POSITIVE_OR_INFINITE, None, math.inf, "--surface-radius"),
+    Quantity("surface_thickness", "h", "surface thickness h", "length", "mm", 1e3,
+             "thickness of a cushion, pad or belt cover on a rigid substrate (default inf: a half-space)",
+             POSITIVE_OR_INFINITE, None, math.inf, "--surface-thickness"),
+    Quantity("partner_mass", "m_2", "partner mass m_2", "mass", "g", 1e3,
+             "mass of a free partner (another fruit): the reduced mass m m_2/(m + m_2) moves; --velocity is then "
+             "the approach speed (default inf: a fixed surface)",
+             POSITIVE_OR_INFINITE, Range(1e-3, math.inf, True, True), math.inf, "--partner-mass"),
+    Quantity("yield_pressure", "p_y", "yield pressure p_y", "modulus", "MPa", 1e-6,
+             "Thornton's limiting contact pressure: elastic-perfectly plastic contact above it "
+             "(default inf: elastic; with --model hertz pure Thornton)",
+             POSITIVE_OR_INFINITE, Range(1e4, 2e7, True, True), math.inf, "--yield-pressure"),
+    Quantity("bioyield_force", "F_pc", "bioyield force F_pc", "force", "N", 1.0,
+             "the paper's critical force of the bioyield element (eq 17), read as Thornton's yield force: "
+             "instead of --yield-pressure",
+             POSITIVE, Range(0.01, 1e4, True, True), None, "--bioyield-force"),
+    Quantity("failure_stress", "σ_f", "failure stress σ_f", "modulus", "MPa", 1e-6,
+             "failure (bioyield) stress of the flesh for the bruise criterion (needs --criterion; "
+             "default: the --fruit's, else 0.32 MPa, apple flesh)",
+             POSITIVE, Range(1e4, 5e6, True, True), None, "--failure-stress"),
+    Quantity("bruise_susceptibility", "BS", "bruise susceptibility BS", "susceptibility", "cm³/J", 1e6,
+             "bruise volume per joule of absorbed energy above the threshold (default: the --fruit's, "
+             "else 4.6 cm³/J, apples)",
+             NON_NEGATIVE, Range(1e-7, 5e-5, True, True), None, "--bruise-susceptibility"),
+    Quantity("bruise_energy", "W_th", "bruise threshold energy W_th", "energy", "mJ", 1e3,
+             "absorbed energy at bruise onset: the energy criterion's threshold, subtracted from the "
+             "absorbed energy in the bruise volume (default: the --fruit's for the energy criterion, else 0 J)",
+             NON_NEGATIVE, Range(0.0, 5.0, True, True), None, "--bruise-energy"),
     Quantity("step", "Δt", "RK4 step Δt", "time", "ms", 1e3, "RK4 time step (default 1e-4 s, the paper's)",
              POSITIVE, None, 1e-4, "--step"),
     Quantity("model", "", "damping law", "text", "", 1.0, "damping law (fruitimpact models)",
@@ -188,10 +215,27 @@ INPUTS: dict[str, Quantity] = _table(
     Quantity("method", "", "method", "text", "", 1.0,
              "accurate (exact) or rk4 (the paper's fixed-step method)",
              default="accurate", option="--method", choices="method"),
+    Quantity("fruit", "", "fruit", "text", "", 1.0,
+             "a fruit of the library (fruitimpact fruits): its mass, diameter, modulus, Poisson's ratio and "
+             "damage properties, each overridden by its own option",
+             default="jonathan-apple", option="--fruit", choices="fruit"),
+    Quantity("surface", "", "surface", "text", "", 1.0,
+             "a surface of the library (fruitimpact surfaces; fruit: an identical free fruit), each property "
+             "overridden by its own option",
+             default="rigid", option="--surface", choices="surface"),
+    Quantity("surface_model", "", "surface model", "text", "", 1.0,
+             "half-space (Hertz through E* and R) or layer (elastic-foundation cushion of thickness h on a rigid "
+             "substrate); default: the --surface's",
+             default="preset", option="--surface-model", choices="surface_model"),
+    Quantity("criterion", "", "bruise criterion", "text", "", 1.0,
+             "bruise onset: pressure (p_0 >= σ_f), shear (τ_max >= σ_f/2) or energy (W >= W_th); none: no "
+             "bruise assessment",
+             default="none", option="--criterion", choices="criterion"),
 )
 
 #: Inputs given in several ways: at most one of each group (the first is the default way).
-ALTERNATIVES = (("velocity", "drop_height"), ("restitution", "alpha", "damping"))
+ALTERNATIVES = (("velocity", "drop_height"), ("restitution", "alpha", "damping"),
+                ("yield_pressure", "bioyield_force"))
 #: Defaults of the optional inputs when no alternative of their group is given.
 GROUP_DEFAULTS = {"velocity": JONATHAN_VELOCITY, "restitution": JONATHAN_RESTITUTION}
 
@@ -262,7 +306,32 @@ OUTPUTS: dict[str, Quantity] = _table(
              "damping / stiffness (s/m for the power-law family)"),
     Quantity("target_restitution", "e_0", "target restitution", "dimensionless", "", 1.0,
              "the restitution the damping was calibrated for (NaN when α or λ was given)"),
+    Quantity("yield_velocity", "V_y", "yield velocity V_y", "velocity", "m/s", 1.0,
+             "impact velocity at which the contact starts to yield (inf: elastic)"),
+    Quantity("permanent_deflection", "δ_p", "permanent deflection δ_p", "length", "mm", 1e3,
+             "deflection left after the impact (Thornton's unloading)"),
+    Quantity("plastic_work", "W_p", "plastic work W_p", "energy", "mJ", 1e3,
+             "work of the rate-independent force around its loop ∮F_T dδ"),
+    Quantity("viscous_work", "W_v", "viscous work W_v", "energy", "mJ", 1e3,
+             "work of the damping, ∫ c F_T δ̇² dt; W_p + W_v = absorbed energy"),
+    Quantity("fruit_energy", "W_f", "energy absorbed by the fruit", "energy", "mJ", 1e3,
+             "the fruit's share of the absorbed energy (the rest is the partner's or the pad's)"),
+    Quantity("max_shear_stress", "τ_max", "max shear stress τ_max", "modulus", "MPa", 1e-6,
+             "largest subsurface shear stress under the contact, τ_max/p_0 from Hertz's field for the fruit's ν"),
+    Quantity("bruise_margin", "", "bruise margin", "dimensionless", "", 1.0,
+             "criterion's stress (or energy) over its threshold, minus 1: >= 0 is a bruise"),
+    Quantity("bruised", "", "bruised", "boolean", "", 1.0, "1 where the criterion says bruised (NaN: no criterion)"),
+    Quantity("bruise_volume", "BV", "bruise volume BV", "volume", "mm³", 1e9,
+             "BS (W_f − W_th)₊ where bruised"),
+    Quantity("bruise_depth", "d_b", "bruise depth", "length", "mm", 1e3,
+             "depth of a spherical-cap bruise of that volume and width"),
+    Quantity("bruise_width", "w_b", "bruise width", "length", "mm", 1e3,
+             "surface width of the bruise: contact width / 1.4 (Stropek & Gołacki 2020)"),
 )
+
+#: The damage outputs (issue 7), after the law columns.
+DAMAGE_NAMES = ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work", "fruit_energy",
+                "max_shear_stress", "bruise_margin", "bruised", "bruise_volume", "bruise_depth", "bruise_width")
 
 #: The characteristics proper (the engine's columns, in its order): summarised by default.
 CHARACTERISTIC_NAMES = tuple(list(OUTPUTS)[:12])
@@ -285,6 +354,6 @@ def option_of(name: str) -> str:
     return quantity.option if quantity is not None and quantity.option else "--" + name.replace("_", "-")
 
 
-__all__ = ["ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
+__all__ = ["DAMAGE_NAMES", "ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
            "GROUP_DEFAULTS", "INPUTS", "NON_NEGATIVE", "NUMERIC_DEFAULTS", "PLAUSIBLE_BOUNDS", "inside", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
            "Range", "TEXT_INPUTS", "input_quantity", "option_of"]

@@ -26,6 +26,10 @@ UNITS: dict[str, dict[str, float]] = {
     "firmness_star": {"N/s^2": 1.0, "N/s2": 1.0, "N/s²": 1.0, "N/ms^2": 1e6, "N/ms2": 1e6, "N/ms²": 1e6},
     "energy": {"J": 1.0, "mJ": 1e-3},
     "frequency": {"Hz": 1.0, "kHz": 1e3},
+    "susceptibility": {"m3/J": 1.0, "m^3/J": 1.0, "cm3/J": 1e-6, "cm^3/J": 1e-6, "ml/J": 1e-6, "mm3/J": 1e-9,
+                       "mm^3/J": 1e-9},
+    "volume": {"m3": 1.0, "m^3": 1.0, "cm3": 1e-6, "cm^3": 1e-6, "ml": 1e-6, "mm3": 1e-9, "mm^3": 1e-9},
+    "boolean": {"": 1.0},
     "dimensionless": {"": 1.0, "%": 1e-2},
 }
 
@@ -34,7 +38,7 @@ SI_UNIT = {
     "mass": "kg", "length": "m", "modulus": "Pa", "velocity": "m/s", "time": "s",
     "stiffness": "N/m^1.5", "alpha": "s/m", "damping": "N·s/m^2.5", "force": "N", "energy": "J",
     "firmness": "N/s", "firmness_star": "N/s²",
-    "frequency": "Hz", "dimensionless": "",
+    "frequency": "Hz", "dimensionless": "", "susceptibility": "m³/J", "volume": "m³", "boolean": "",
 }
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf(?:inity)?|[-+]?nan)\s*(.*?)\s*$",

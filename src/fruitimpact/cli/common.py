@@ -100,20 +100,10 @@ def _add_impact_options(parser: argparse.ArgumentParser) -> None:
             group.add_argument(quantity.option, metavar=choices, help=f"{quantity.doc} (default {quantity.default})")
 
 
-#: The inputs that describe the fruit and the surface (``Fruit`` and ``Surface`` fields).
-_FRUIT = ("mass", "diameter", "modulus", "poisson", "stiffness")
-_SURFACE = {"surface_modulus": "modulus", "surface_poisson": "poisson", "surface_radius": "radius"}
-
-
 def _simulate_kwargs(args) -> dict:
-    """``simulate()`` keywords from the given options, as typed (the library reads the units)."""
-    from ..impact import Fruit, Surface
-
-    given = {name: getattr(args, name) for name in INPUTS if getattr(args, name, None) is not None}
-    fruit = _library_call(Fruit, **{name: given.pop(name) for name in _FRUIT if name in given})
-    surface_fields = {field: given.pop(name) for name, field in _SURFACE.items() if name in given}
-    surface = _library_call(Surface, **surface_fields) if surface_fields else None
-    return dict(fruit=fruit, surface=surface, **given)
+    """``simulate()`` keywords from the given options, as typed (the library reads the units):
+    every input by its name, ``fruit`` and ``surface`` as library names."""
+    return {name: getattr(args, name) for name in INPUTS if getattr(args, name, None) is not None}
 
 
 def _json_default(value):

@@ -1,0 +1,61 @@
+"""The bruise columns of a table of impacts: one criterion per row, named in every output.
+
+The rules (docs/damage.md):
+
+* the criterion compares the impact's peak contact pressure p_0 (``pressure``),
+  the largest subsurface shear τ_max = (τ_max/p_0)(ν) p_0 of Hertz's field
+  (``shear``), or the energy absorbed by the fruit W_f (``energy``) with its
+  threshold (σ_f, σ_f/2 or W_th);
+* the bruise volume is BS (W_f − W_th)₊ where the criterion says bruised, 0
+  elsewhere (Opara & Pathare 2014: BV = BS (E − E_th)₊), W_f being the fruit's
+  share of the absorbed energy ½ m* V² (1 − e²);
+* the bruise is a spherical cap of width 2a/1.4 (a the contact radius; pear data,
+  Stropek & Gołacki 2020) holding that volume, which fixes its depth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import bruise
+
+#: Criterion codes of the ``criterion`` text input (``none`` first).
+CRITERION_NAMES = ("none", "pressure", "shear", "energy")
+
+
+def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energy, failure_stress,
+                   threshold_energy, susceptibility, contact_radius, valid) -> dict[str, np.ndarray]:
+    """``max_shear_stress``, ``bruise_margin``, ``bruised``, ``bruise_volume``, ``bruise_depth`` and
+    ``bruise_width`` of every row (arrays of the table's length; NaN where no criterion applies or
+    the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``."""
+    rows = criterion.shape[0]
+    nan = np.full(rows, np.nan)
+    out = {name: nan.copy() for name in ("max_shear_stress", "bruise_margin", "bruised", "bruise_volume",
+                                         "bruise_depth", "bruise_width")}
+    # laws with a force at first touch (Kelvin–Voigt) have no finite Hertz pressure: no stress criterion there
+    finite = valid & np.isfinite(peak_pressure) & np.isfinite(fruit_energy)
+    shear_ok = finite & (poisson >= 0.0) & (poisson <= 0.5)
+    if shear_ok.any():
+        out["max_shear_stress"][shear_ok] = bruise.max_shear_stress(peak_pressure[shear_ok], poisson[shear_ok])
+    for code, name in enumerate(CRITERION_NAMES):
+        if name == "none":
+            continue
+        rows_of = np.flatnonzero(finite & (criterion == code) & (shear_ok if name == "shear" else True))
+        if rows_of.size == 0:
+            continue
+        margin = bruise.CRITERIA[name].margin(
+            peak_pressure=peak_pressure[rows_of], poisson=poisson[rows_of], absorbed_energy=fruit_energy[rows_of],
+            failure_stress=failure_stress[rows_of], threshold_energy=threshold_energy[rows_of])
+        out["bruise_margin"][rows_of] = margin
+        bruised = margin >= 0.0
+        out["bruised"][rows_of] = bruised
+        volume = bruise.bruise_volume(fruit_energy[rows_of], susceptibility[rows_of], threshold_energy[rows_of],
+                                      bruised)
+        depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of])
+        out["bruise_volume"][rows_of] = volume
+        out["bruise_depth"][rows_of] = depth
+        out["bruise_width"][rows_of] = width
+    return out
+
+
+__all__ = ["CRITERION_NAMES", "bruise_columns"]

@@ -1,0 +1,392 @@
+"""The fruit and surface libraries: sourced property values with ranges (issue 7, item 3).
+
+Data live in ``data/fruits.csv`` and ``data/surfaces.csv`` (SI units, one row per entry); this
+module reads them once with the standard library only (no pandas, no numpy), checks them and
+serves them as frozen records.  docs/library.md has the tables and what the flags mean.
+
+>>> fruit("jonathan-apple").inputs()["modulus"]
+3000000.0
+>>> surface("foam-pad").model
+'layer'
+
+Every number is a :class:`Value`: a central value, a range [low, high], its unit, the source it
+was read in, and ``confirmed``: ``True`` where the value was read in that source (an article, its
+abstract, an engineering table), or derived from read values by the arithmetic the source text
+states after ``derived:``; ``False`` where it was not checked in a source, with a ``note`` saying
+what it rests on.  ``low == high`` where one value was read and no spread was given.
+
+Sources (full references in the CSVs' ``*_source`` columns): the founding paper, "Theoretical
+aspects about simulating the reaction to impact of apples on rigid plane surfaces" (the Jonathan
+apple); Gorji Chakespari et al., Modern Applied Science, and Food & Machinery 31(5) (apple flesh
+failure stress and moduli); Int. J. Food Properties doi 10.1080/10942912.2013.831444 (apple
+density); Int. J. Biosystems Eng. article 35202 (apple bruise susceptibility); Stropek & Gołacki
+2020 (pear bruise susceptibility); Fu et al., "'Jazz' apple impact bruise responses to different
+cushioning materials" (foam pads); engineering tables after Halliday et al., Gere and Ashby, and
+the Mechanical Engineering Handbook (steel, concrete, PVC, rubber).
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from importlib import resources
+from types import MappingProxyType
+
+__all__ = ["FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit", "LibraryError", "Surface", "Value",
+           "fruit", "fruit_rows", "fruits", "surface", "surface_rows", "surfaces"]
+
+#: The numeric fields of a fruit and their SI units.
+FRUIT_UNITS = {
+    "mass": "kg", "diameter": "m", "density": "kg/m^3", "modulus": "Pa", "poisson": "", "failure_stress": "Pa",
+    "restitution": "", "alpha": "s/m", "bruise_susceptibility": "m^3/J", "bruise_threshold_energy": "J",
+}
+#: The numeric fields of a surface and their SI units.
+SURFACE_UNITS = {"modulus": "Pa", "poisson": "", "thickness": "m", "radius": "m"}
+#: Contact models of a surface: Hertz half-space through E* and R; elastic-foundation (Winkler) layer of
+#: thickness h on a rigid substrate; an identical free fruit.
+SURFACE_MODELS = ("half-space", "layer", "fruit")
+
+_FRUIT_REQUIRED = ("mass", "diameter", "modulus", "poisson")
+_POSITIVE = {"mass", "diameter", "density", "modulus", "failure_stress", "alpha", "bruise_susceptibility",
+             "bruise_threshold_energy", "thickness", "radius"}
+
+
+class LibraryError(ValueError):
+    """A library CSV breaks a rule (missing source, value outside its range, duplicate name...)."""
+
+
+@dataclass(frozen=True)
+class Value:
+    """One sourced number.
+
+    Attributes
+    ----------
+    value : float
+        The central value [``unit``], SI.
+    low, high : float
+        Its range [``unit``]; ``low <= value <= high``.
+    unit : str
+        SI unit (``""`` for dimensionless).
+    source : str
+        Where it was read (or ``derived: ...`` and from what).
+    confirmed : bool
+        ``True``: read in ``source`` or derived from read values; ``False``: not checked in a source.
+    note : str
+        What the value is and what it rests on; never empty when not confirmed.
+    """
+
+    value: float
+    low: float
+    high: float
+    unit: str
+    source: str
+    confirmed: bool
+    note: str = ""
+
+    @property
+    def derived(self) -> bool:
+        """Whether the value was computed from other values (its source starts with ``derived``)."""
+        return self.source.lower().startswith("derived")
+
+    def to_dict(self) -> dict:
+        """The value as a plain dict (JSON-ready; ``inf`` stays a float)."""
+        return {item.name: getattr(self, item.name) for item in fields(self)}
+
+
+@dataclass(frozen=True)
+class Fruit:
+    """A fruit of the library: each property a :class:`Value` in SI, or ``None`` where unknown.
+
+    Attributes
+    ----------
+    name, description : str
+    modulus_kind : str
+        Which modulus ``modulus`` is (impact/apparent Hertz modulus or quasi-static compression modulus).
+    source : str
+        The row's main sources.
+    mass : Value
+        M [kg].
+    diameter : Value
+        d [m]; the local contact radius is d/2 (non-spherical fruit: an equal-volume or equatorial
+        diameter, see the note).
+    density : Value or None
+        ρ [kg/m³].
+    modulus : Value
+        Young's modulus E [Pa] (see ``modulus_kind``).
+    poisson : Value
+        ν [-].
+    failure_stress : Value or None
+        Flesh failure (bioyield) stress σ_f [Pa].
+    restitution : Value or None
+        Coefficient of restitution on a rigid plate [-].
+    alpha : Value or None
+        Hunt–Crossley α [s/m] (k = 1 − α V_i, the paper's eq 6).
+    bruise_susceptibility : Value or None
+        Bruise volume per unit energy [m³/J] (1 cm³/J = 1e-6 m³/J).
+    bruise_threshold_energy : Value or None
+        Energy below which no bruise formed [J].
+    """
+
+    name: str
+    description: str
+    modulus_kind: str
+    source: str
+    mass: Value
+    diameter: Value
+    density: Value | None
+    modulus: Value
+    poisson: Value
+    failure_stress: Value | None
+    restitution: Value | None
+    alpha: Value | None
+    bruise_susceptibility: Value | None
+    bruise_threshold_energy: Value | None
+
+    def values(self) -> dict[str, Value]:
+        """The known numeric properties, by field name."""
+        return {name: getattr(self, name) for name in FRUIT_UNITS if getattr(self, name) is not None}
+
+    def inputs(self) -> dict[str, float]:
+        """Simulator inputs in SI: ``mass`` [kg], ``diameter`` [m], ``modulus`` [Pa], ``poisson`` [-], and
+        where known ``failure_stress`` [Pa], ``bruise_susceptibility`` [m³/J], ``bruise_threshold_energy``
+        [J], ``restitution`` [-] (central values, confirmed or not)."""
+        names = ("mass", "diameter", "modulus", "poisson", "failure_stress", "bruise_susceptibility",
+                 "bruise_threshold_energy", "restitution")
+        return {name: getattr(self, name).value for name in names if getattr(self, name) is not None}
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A surface of the library.
+
+    Attributes
+    ----------
+    name, description : str
+    model : str
+        ``half-space`` (Hertz through E* and R), ``layer`` (elastic-foundation/Winkler layer of
+        thickness h on a rigid substrate, k = (1−ν)E/((1+ν)(1−2ν)h)) or ``fruit`` (an identical free fruit).
+    source : str
+        The row's main sources.
+    modulus : Value or None
+        Young's modulus E₂ [Pa]; ``None`` for ``fruit`` (taken from the fruit).
+    poisson : Value or None
+        ν₂ [-]; ``None`` for ``fruit``.
+    thickness : Value or None
+        h [m]; ``inf`` for a half-space; ``None`` for ``fruit``.
+    radius : Value or None
+        Radius of curvature R₂ [m]; ``inf`` is flat; ``None`` for ``fruit`` (the fruit's d/2).
+    partner : str or None
+        ``"fruit"`` for the identical free fruit, else ``None``.
+    """
+
+    name: str
+    description: str
+    model: str
+    source: str
+    modulus: Value | None
+    poisson: Value | None
+    thickness: Value | None
+    radius: Value | None
+    partner: str | None
+
+    def values(self) -> dict[str, Value]:
+        """The known numeric properties, by field name."""
+        return {name: getattr(self, name) for name in SURFACE_UNITS if getattr(self, name) is not None}
+
+    def inputs(self, fruit: Fruit | None = None) -> dict:
+        """Simulator inputs in SI: ``surface_modulus`` [Pa], ``surface_poisson`` [-], ``surface_radius`` [m],
+        ``surface_thickness`` [m] (``inf`` for a half-space), ``surface_model`` (text).
+
+        For the ``fruit`` surface the numbers are the fruit's (modulus, Poisson ratio, radius d/2, an
+        infinite thickness) when ``fruit`` is given, else ``None``; the reduced mass m/2 is the
+        caller's to apply.
+        """
+        if self.partner != "fruit":
+            modulus, poisson = self.modulus.value, self.poisson.value
+            radius, thickness = self.radius.value, self.thickness.value
+        elif fruit is None:
+            modulus = poisson = radius = thickness = None
+        else:
+            modulus, poisson = fruit.modulus.value, fruit.poisson.value
+            radius, thickness = fruit.diameter.value / 2.0, math.inf
+        return {"surface_modulus": modulus, "surface_poisson": poisson, "surface_radius": radius,
+                "surface_thickness": thickness, "surface_model": self.model}
+
+
+# ----------------------------------------------------------------------------------------------- loading
+
+def _read(filename: str) -> list[dict[str, str]]:
+    text = resources.files("fruitimpact").joinpath("data", filename).read_text(encoding="utf-8")
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def _number(text: str, where: str) -> float:
+    try:
+        number = float(text)
+    except ValueError:
+        raise LibraryError(f"{where}: {text!r} is not a number") from None
+    if math.isnan(number):
+        raise LibraryError(f"{where}: NaN is not a value")
+    return number
+
+
+def _value(row: dict[str, str], name: str, unit: str, where: str) -> Value | None:
+    keys = [name, f"{name}_low", f"{name}_high", f"{name}_confirmed", f"{name}_source", f"{name}_note"]
+    missing = [key for key in keys if key not in row]
+    if missing:
+        raise LibraryError(f"{where}: missing columns {', '.join(missing)}")
+    text = row[name].strip()
+    if not text:
+        filled = [key for key in keys[1:] if row[key].strip()]
+        if filled:
+            raise LibraryError(f"{where}: {name} is empty but {', '.join(filled)} is not")
+        return None
+    where = f"{where}, {name}"
+    value = _number(text, where)
+    low = _number(row[f"{name}_low"].strip(), f"{where}_low")
+    high = _number(row[f"{name}_high"].strip(), f"{where}_high")
+    if not low <= value <= high:
+        raise LibraryError(f"{where}: value {value:g} is outside its range [{low:g}, {high:g}]")
+    confirmed = row[f"{name}_confirmed"].strip().lower()
+    if confirmed not in ("true", "false"):
+        raise LibraryError(f"{where}_confirmed must be true or false; got {confirmed!r}")
+    source = row[f"{name}_source"].strip()
+    note = row[f"{name}_note"].strip()
+    if not source:
+        raise LibraryError(f"{where} has no source")
+    if confirmed == "false" and not note:
+        raise LibraryError(f"{where} is not confirmed and has no note saying why")
+    if name in _POSITIVE and not low > 0.0:
+        raise LibraryError(f"{where} must be positive; its range starts at {low:g}")
+    if name == "poisson" and not (-1.0 < low and high < 0.5):
+        raise LibraryError(f"{where} must lie in (-1, 0.5); its range is [{low:g}, {high:g}]")
+    if name in ("restitution", "poisson") and math.isinf(high):
+        raise LibraryError(f"{where} must be finite")
+    return Value(value, low, high, unit, source, confirmed == "true", note)
+
+
+def _common(row: dict[str, str], kind: str, number: int, names: set[str]) -> tuple[str, str]:
+    name = (row.get("name") or "").strip()
+    where = f"{kind}s.csv row {number} ({name or 'no name'})"
+    if not name or name != name.lower() or " " in name:
+        raise LibraryError(f"{where}: a name is lower-case without spaces; got {name!r}")
+    if name in names:
+        raise LibraryError(f"{where}: duplicate name {name!r}")
+    if not (row.get("source") or "").strip():
+        raise LibraryError(f"{where} has no source")
+    names.add(name)
+    return name, where
+
+
+@functools.cache
+def fruits() -> Mapping[str, Fruit]:
+    """The fruit library, read-only, in file order (read and checked once)."""
+    table, names = {}, set()
+    for number, row in enumerate(_read("fruits.csv"), start=1):
+        name, where = _common(row, "fruit", number, names)
+        values = {field: _value(row, field, unit, where) for field, unit in FRUIT_UNITS.items()}
+        absent = [field for field in _FRUIT_REQUIRED if values[field] is None]
+        if absent:
+            raise LibraryError(f"{where}: {', '.join(absent)} must be given")
+        modulus_kind = row["modulus_kind"].strip()
+        if not modulus_kind:
+            raise LibraryError(f"{where}: modulus_kind must say which modulus is stored")
+        table[name] = Fruit(name=name, description=row["description"].strip(), modulus_kind=modulus_kind,
+                            source=row["source"].strip(), **values)
+    return MappingProxyType(table)
+
+
+@functools.cache
+def surfaces() -> Mapping[str, Surface]:
+    """The surface library, read-only, in file order (read and checked once)."""
+    table, names = {}, set()
+    for number, row in enumerate(_read("surfaces.csv"), start=1):
+        name, where = _common(row, "surface", number, names)
+        model = row["model"].strip()
+        partner = row["partner"].strip() or None
+        values = {field: _value(row, field, unit, where) for field, unit in SURFACE_UNITS.items()}
+        if model not in SURFACE_MODELS:
+            raise LibraryError(f"{where}: model must be one of {', '.join(SURFACE_MODELS)}; got {model!r}")
+        given = [field for field, value in values.items() if value is not None]
+        if model == "fruit":
+            if partner != "fruit" or given:
+                raise LibraryError(f"{where}: a fruit surface has partner 'fruit' and no numbers")
+        else:
+            if partner is not None:
+                raise LibraryError(f"{where}: only a fruit surface has a partner")
+            absent = [field for field, value in values.items() if value is None]
+            if absent:
+                raise LibraryError(f"{where}: {', '.join(absent)} must be given")
+            thickness = values["thickness"]
+            if model == "half-space" and not math.isinf(thickness.value):
+                raise LibraryError(f"{where}: a half-space has an infinite thickness")
+            if model == "layer" and math.isinf(thickness.high):
+                raise LibraryError(f"{where}: a layer has a finite thickness")
+        table[name] = Surface(name=name, description=row["description"].strip(), model=model,
+                              source=row["source"].strip(), partner=partner, **values)
+    return MappingProxyType(table)
+
+
+def fruit(name: str) -> Fruit:
+    """The library fruit ``name``; ``ValueError`` naming the known fruits otherwise."""
+    table = fruits()
+    try:
+        return table[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"fruit must be one of {', '.join(table)}; got {name!r}") from None
+
+
+def surface(name: str) -> Surface:
+    """The library surface ``name``; ``ValueError`` naming the known surfaces otherwise."""
+    table = surfaces()
+    try:
+        return table[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"surface must be one of {', '.join(table)}; got {name!r}") from None
+
+
+# ----------------------------------------------------------------------------------------------- listing
+
+def _row(entry, units: dict[str, str], text: tuple[str, ...]) -> dict:
+    row = {key: getattr(entry, key) for key in text}
+    for name, unit in units.items():
+        value = getattr(entry, name)
+        row.update({name: None if value is None else value.value,
+                    f"{name}_low": None if value is None else value.low,
+                    f"{name}_high": None if value is None else value.high,
+                    f"{name}_unit": unit,
+                    f"{name}_confirmed": None if value is None else value.confirmed,
+                    f"{name}_source": None if value is None else value.source,
+                    f"{name}_note": None if value is None else value.note})
+    return row
+
+
+def fruit_rows() -> list[dict]:
+    """The fruit table for listing (``fruitimpact fruits``, table or JSON): one flat dict per fruit with
+    ``name``, ``description``, ``modulus_kind``, ``source`` and, per property X of :data:`FRUIT_UNITS`,
+    ``X`` (SI, ``None`` if unknown), ``X_low``, ``X_high``, ``X_unit``, ``X_confirmed``, ``X_source``,
+    ``X_note``."""
+    return [_row(entry, FRUIT_UNITS, ("name", "description", "modulus_kind", "source"))
+            for entry in fruits().values()]
+
+
+def surface_rows() -> list[dict]:
+    """The surface table for listing (``fruitimpact surfaces``): one flat dict per surface with ``name``,
+    ``description``, ``model``, ``partner``, ``source`` and, per property X of :data:`SURFACE_UNITS`,
+    ``X``, ``X_low``, ``X_high``, ``X_unit``, ``X_confirmed``, ``X_source``, ``X_note``."""
+    return [_row(entry, SURFACE_UNITS, ("name", "description", "model", "partner", "source"))
+            for entry in surfaces().values()]
+
+
+def __getattr__(name: str):
+    """``FRUITS`` and ``SURFACES`` (the registries, same as :func:`fruits` and :func:`surfaces`), read on
+    first use."""
+    if name == "FRUITS":
+        return fruits()
+    if name == "SURFACES":
+        return surfaces()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

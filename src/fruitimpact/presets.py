@@ -1,0 +1,141 @@
+"""Library presets (``--fruit NAME``, ``--surface NAME``) as per-row defaults of the inputs.
+
+A preset replaces the *defaults* of the inputs it knows, never a value the user
+gave: ``--fruit apple --mass 150g`` is the library apple with a 150 g mass.  The
+``fruit`` surface is an identical free fruit: its modulus, Poisson's ratio and
+radius are the fruit's as used, and its mass the partner mass (the reduced mass
+m/2 moves, ``--velocity`` is the approach speed).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import library
+from .quantities import INPUTS
+
+#: The library's names of fruit properties that differ from the inputs' names.
+_FRUIT_KEYS = {"bruise_threshold_energy": "bruise_energy"}
+#: Surface models as codes.
+HALF_SPACE, LAYER = 0, 1
+#: Defaults of the damage inputs when neither the user nor the fruit gives one (docs/damage.md).
+DAMAGE_DEFAULTS = {
+    "failure_stress": 0.32e6,  # apple flesh, Gorji Chakespari et al., Modern Applied Science (0.29-0.37 MPa)
+    "bruise_susceptibility": 4.66e-6,  # apples, five cultivars 3.71-6.23 cm³/J (Int. J. Biosystems Eng.)
+    "bruise_energy": 0.0,
+}
+
+
+@dataclass
+class Resolved:
+    """The per-row defaults after presets: ``defaults`` (input name → a float for every row, or an
+    array of one value per row; only the inputs that presets or damage defaults touch), the
+    surface model code per row, the default target restitution (float or per row), and the rows
+    whose ``bruise_energy`` comes from nobody (neither given nor in the fruit's library entry)."""
+
+    defaults: dict
+    surface_model: np.ndarray
+    restitution: np.ndarray | float
+    no_threshold: np.ndarray
+
+    def apply(self, used: dict, given: dict) -> None:
+        """Replace the table defaults in ``used`` (name → array) where the input was not given."""
+        for name, value in self.defaults.items():
+            if not np.all(given[name]):
+                used[name] = np.where(given[name], used[name], value)
+
+
+class _Defaults(dict):
+    """name → scalar, or per-row array once two groups of rows differ."""
+
+    def __init__(self, rows: int):
+        super().__init__()
+        self.rows = rows
+
+    def put(self, name: str, where, value, everywhere: bool) -> None:
+        if everywhere:
+            self[name] = value
+            return
+        current = self.get(name, INPUTS[name].default if INPUTS[name].default is not None else math.nan)
+        if np.ndim(current) == 0:
+            current = np.full(self.rows, current, dtype=float)
+            self[name] = current
+        current[where] = value
+
+
+def resolve(inputs, default_restitution: float) -> Resolved:
+    """Per-row defaults of ``inputs`` (``inputs.InputColumns``) from the ``fruit`` and ``surface``
+    presets and the damage defaults."""
+    rows = inputs.rows
+    defaults = _Defaults(rows)
+    for name, value in DAMAGE_DEFAULTS.items():
+        defaults[name] = value
+    no_threshold = np.ones(rows, dtype=bool)
+    restitution = default_restitution
+    fruit_labels = inputs.text["fruit"]
+    fruits = library.fruits()
+    single = len(fruit_labels.labels) == 1
+    for code, name in enumerate(fruit_labels.labels):
+        if name not in fruits:
+            continue  # refused by the text check
+        where = slice(None) if single else fruit_labels.codes == code
+        for key, value in fruits[name].inputs().items():
+            key = _FRUIT_KEYS.get(key, key)
+            if value is None:
+                continue
+            if key == "restitution":
+                if single:
+                    restitution = value
+                else:
+                    if np.ndim(restitution) == 0:
+                        restitution = np.full(rows, restitution)
+                    restitution[where] = value
+                continue
+            defaults.put(key, where, value, single)
+            if key == "bruise_energy":
+                no_threshold[where] = False
+
+    def used(name):
+        value = defaults.get(name, INPUTS[name].default)
+        return np.where(inputs.given[name], inputs.values[name], value)
+
+    surface_model = np.zeros(rows, dtype=np.int8)
+    surface_labels = inputs.text["surface"]
+    surfaces = library.surfaces()
+    single = len(surface_labels.labels) == 1
+    for code, name in enumerate(surface_labels.labels):
+        if name not in surfaces:
+            continue  # rigid (no preset) or refused by the text check
+        where = slice(None) if single else surface_labels.codes == code
+        preset = surfaces[name].inputs()
+        if preset["surface_model"] == "fruit":
+            for key, source in (("surface_modulus", "modulus"), ("surface_poisson", "poisson"),
+                                ("partner_mass", "mass")):
+                defaults.put(key, where, used(source)[where], single)
+            defaults.put("surface_radius", where, used("diameter")[where] / 2.0, single)
+            continue
+        for key in ("surface_modulus", "surface_poisson", "surface_radius", "surface_thickness"):
+            if preset[key] is not None:
+                defaults.put(key, where, preset[key], single)
+        if preset["surface_model"] == "layer":
+            surface_model[where] = LAYER
+    model_labels = inputs.text["surface_model"]
+    for code, name in enumerate(model_labels.labels):
+        if name in ("half-space", "layer"):
+            surface_model[model_labels.codes == code] = LAYER if name == "layer" else HALF_SPACE
+    return Resolved(dict(defaults), surface_model, restitution, no_threshold)
+
+
+def effective_mass(mass, partner_mass):
+    """Reduced mass m m_2/(m + m_2) [kg]; a fixed surface (m_2 = inf) leaves m."""
+    mass = np.asarray(mass, dtype=float)
+    partner_mass = np.asarray(partner_mass, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isinf(partner_mass), mass, mass * partner_mass / (mass + partner_mass))
+
+
+__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "Resolved", "effective_mass", "resolve"]
+assert all(name in INPUTS for name in DAMAGE_DEFAULTS) and math.isfinite(DAMAGE_DEFAULTS["failure_stress"])
