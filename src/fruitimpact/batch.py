@@ -75,6 +75,7 @@ class Evaluation:
     block: np.ndarray | None = None  # the characteristics as the engine wrote them (rows × 12)
     plastic: np.ndarray | None = None  # rows computed by the plastic engine (yield pressure or a layer)
     kernel_arguments: dict | None = None  # those rows' arguments of engine.plastic (for their curves)
+    plastic_block: np.ndarray | None = None  # engine.plastic.PLASTIC_COLUMNS of those rows (NaN elsewhere)
 
     def labels(self) -> dict[str, Labels]:
         """``status``, ``message`` and ``warnings`` as ``Labels`` (no message on a row: its status)."""
@@ -383,7 +384,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     arguments = dict(mass=mass, velocity=velocity, stiffness=stiffness, radius=radius,
                      contact_modulus=contact_modulus, yield_pressure=yield_pressure, layer_stiffness=layer_stiffness,
                      thickness=thickness, damping_factor=factor)
-    return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments)
+    return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments, plastic_block)
 
 
 def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness, messages: MessageBook) -> None:

@@ -14,12 +14,13 @@ import importlib
 import sys
 
 PROG = "fruitimpact"
-COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population")
+COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population", "drop", "safe-height", "line", "fruits",
+            "surfaces")
 
 
 def build_parser():
     """The argparse parser of every command (built from the table of quantities)."""
-    from . import reference, runs, simulate
+    from . import damage, reference, runs, simulate
     from .common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
@@ -27,6 +28,7 @@ def build_parser():
     simulate.add_parser(sub)
     reference.add_parsers(sub)
     runs.add_parsers(sub)
+    damage.add_parsers(sub)
     return parser
 
 

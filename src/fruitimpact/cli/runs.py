@@ -167,13 +167,14 @@ def _check_constants(constants: dict, text: dict) -> None:
 
 
 def _check_text(name: str, values) -> None:
-    from ..models import CALIBRATIONS, DAMPING_LAWS
-    from ..solvers import SOLVERS
+    from ..quantities import option_of
+    from ..registries import REGISTRIES
 
-    registry = {"model": DAMPING_LAWS, "calibration": CALIBRATIONS, "method": SOLVERS}[name]
+    registry = REGISTRIES[name]
     for value in values:
         if value not in registry:
-            raise UsageError(f"argument --{name}: {name} must be one of {', '.join(registry)}; got {value!r}")
+            raise UsageError(f"argument {option_of(name)}: {name} must be one of {', '.join(registry)}; "
+                             f"got {value!r}")
 
 
 def _check_conflicts(given) -> None:

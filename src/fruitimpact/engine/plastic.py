@@ -71,7 +71,7 @@ PARALLEL_MIN_ROWS = 2000
 
 #: Columns of the plastic block, after the characteristics.
 PLASTIC_COLUMNS = ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work", "yield_force",
-                   "bottomed_out", "fruit_work_share")
+                   "bottomed_out", "fruit_work_share", "unloading_radius")
 N_PLASTIC = len(PLASTIC_COLUMNS)
 
 
@@ -371,14 +371,20 @@ def _pressure_at(F, p, yield_pressure):
     Half-space: Hertz, p0 = 3F/(2π a²), a² = R δ_f (capped at p_y once yielded: Thornton's
     truncated profile).  Layer in series: a² = R (δ_f + 2 δ_L) (Hertz's a² = R δ and the rigid
     sphere on a Winkler layer's a² = 2 R δ_L) and a shape factor interpolated between Hertz's
-    3/2 and the layer's paraboloid 2 by the share of each in a²: an approximation (docs/damage.md)."""
+    3/2 and the layer's paraboloid 2 by the share of each in a²: an approximation (docs/damage.md).
+    Beyond the bottoming-out force F_b, the excess F − F_b presses on the substrate through the crushed pad:
+    its Hertz pressure (6 (F − F_b) E*² / (π³ R²))^(1/3) if that is larger."""
     deflection_fruit = _fruit_load(F, p)[0]
     deflection_layer = _layer(F, p)[0]
     a2 = p[R_] * (deflection_fruit + 2.0 * deflection_layer)
     if a2 <= 0.0:
         return 0.0, 0.0
     shape = (1.5 * deflection_fruit + 4.0 * deflection_layer) / (deflection_fruit + 2.0 * deflection_layer)
-    return min(shape * F / (math.pi * a2), yield_pressure), math.sqrt(a2)
+    pressure = shape * F / (math.pi * a2)
+    if F > p[FB_]:  # a bottomed-out pad: the force beyond F_b meets the substrate, a Hertz contact of its own
+        R = p[R_]
+        pressure = max(pressure, (6.0 * (F - p[FB_]) * p[ES_] ** 2 / (math.pi ** 3 * R * R)) ** (1.0 / 3.0))
+    return min(pressure, yield_pressure), math.sqrt(a2)
 
 
 @nb.njit(**_JIT)
@@ -474,6 +480,8 @@ def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressu
     # the fruit's share of the work of deformation at the turn (the rest is the layer's)
     df, _, i_f = _fruit_load(F_star, p)
     extra[6] = (F_star * df - i_f) / loaded if loaded > 0.0 else 1.0
+    # Thornton's R_p of the flattened contact ((4/3) E* √R_p = K_p; R when it did not yield)
+    extra[7] = (0.75 * p[KU_] / contact_modulus) ** 2
 
 
 @nb.njit(**_JIT)
@@ -576,7 +584,8 @@ def plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, 
     plastic : ndarray (rows, 6)
         ``PLASTIC_COLUMNS``: yield velocity [m/s] (inf: elastic), permanent deflection δ_p [m],
         plastic work W_p [J], viscous work W_v [J], yield force F_y [N], 1 where the layer
-        bottomed out, the fruit's share of the work of deformation at the largest force.  Inputs are not validated here: validate at the boundary.
+        bottomed out, the fruit's share of the work of deformation at the largest force, and the
+        radius R_p [m] of the flattened contact that unloads (R where it did not yield).  Inputs are not validated here: validate at the boundary.
     """
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
                                    (mass, velocity, stiffness, radius, contact_modulus, yield_pressure,

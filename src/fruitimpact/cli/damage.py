@@ -1,0 +1,305 @@
+"""Damage commands: ``drop``, ``safe-height``, ``line``, and the libraries ``fruits`` and ``surfaces``."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+from ..quantities import INPUTS, OUTPUTS
+from .common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
+
+#: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
+MAP_HEIGHTS = 30
+#: Moduli of a firmness map [Pa].
+MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
+
+
+def _without_velocity(args) -> dict:
+    kwargs = _simulate_kwargs(args)
+    for name in ("velocity",):
+        if name in kwargs:
+            raise UsageError(f"argument --{name}: the {args.command} command sets the velocity from the drop height")
+    return kwargs
+
+
+def _check_outputs(pairs) -> None:
+    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
+
+    for option, path, kind in pairs:
+        if path is not None:
+            try:
+                check_output(path, option, CSV_FORMAT if kind == "csv" else FIGURE_FORMATS)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+
+
+def _print_warnings(command: str, warnings) -> None:
+    for warning in warnings:
+        print(f"{PROG} {command}: warning: {warning}", file=sys.stderr)
+
+
+# ----------------------------------------------------------------------------------------------- drop
+def cmd_drop(args) -> int:
+    from ..damage.drops import drop
+
+    kwargs = _without_velocity(args)
+    height = kwargs.pop("drop_height", None)
+    if height is None:
+        raise UsageError("argument --drop-height: required (the height the fruit falls from, e.g. 10cm)")
+    try:
+        max_impacts = int(args.max_impacts)
+    except ValueError:
+        max_impacts = -1
+    if not 1 <= max_impacts <= 1000:
+        raise UsageError(f"argument --max-impacts: must be an integer in [1, 1000]; got {args.max_impacts!r}")
+    report = _library_call(drop, height, max_impacts=max_impacts, **kwargs)
+    _print_warnings("drop", report["warnings"])
+    if args.json:
+        print(dump_json(report))
+    else:
+        print(f"drop from {report['drop_height'] * 100:.4g} cm: {report['impact_count']} impacts, at rest after "
+              f"{report['rest_time']:.3g} s; criterion {report['criterion']}")
+        print(f"{'#':>3} {'V [m/s]':>9} {'e':>7} {'F_max [N]':>10} {'p_0 [MPa]':>10} {'W_p [mJ]':>9} "
+              f"{'W_v [mJ]':>9} {'bruised':>8} {'BV [mm³]':>9}")
+        for impact in report["impacts"]:
+            bruised = "-" if impact["bruised"] is None else ("yes" if impact["bruised"] else "no")
+            volume = impact["bruise_volume"] * 1e9 if math.isfinite(impact["bruise_volume"]) else math.nan
+            print(f"{impact['impact']:>3} {impact['velocity']:>9.4g} {impact['restitution']:>7.4g} "
+                  f"{impact['peak_force']:>10.4g} {impact['max_pressure'] / 1e6:>10.4g} "
+                  f"{impact['plastic_work'] * 1e3:>9.4g} {impact['viscous_work'] * 1e3:>9.4g} {bruised:>8} "
+                  f"{volume:>9.4g}")
+        print(f"absorbed {report['total_absorbed_energy'] * 1e3:.4g} mJ (plastic {report['total_plastic_work'] * 1e3:.4g}"
+              f" mJ, viscous {report['total_viscous_work'] * 1e3:.4g} mJ)"
+              + ("" if report["bruise_volume"] is None else f"; bruise volume {report['bruise_volume'] * 1e9:.4g} mm³"))
+        print(f"rule: {report['accumulation_rule']}")
+        if report["status"] != "ok":
+            print(f"{report['status'].upper()}: {report['message']}")
+    return 0 if report["status"] == "ok" else 1
+
+
+# ---------------------------------------------------------------------------------------- safe height
+def _risk_map(kwargs: dict, by: str):
+    """Rows (dicts) of a bruise-risk map: height × surface or height × modulus, and the safe height of
+    each column, from one evaluation of the whole grid and one root search."""
+    import numpy as np
+
+    from ..batch import evaluation
+    from ..damage.heights import safe_heights
+    from ..registries import SURFACE_CHOICES
+
+    heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
+    if by == "surface":
+        columns = [name for name in SURFACE_CHOICES if name not in ("rigid",)]
+        key = "surface"
+    else:
+        columns = list(MAP_MODULI)
+        key = "modulus"
+    base = {name: value for name, value in kwargs.items() if name not in ("drop_height", key)}
+    n = len(columns) * heights.size
+    table = {name: [value] * n for name, value in base.items()}
+    table[key] = [c for c in columns for _ in heights]
+    table["drop_height"] = [h for _ in columns for h in heights]
+    result = _library_call(evaluation, table)
+    rows = []
+    for i in range(n):
+        rows.append({key: table[key][i], "drop_height": table["drop_height"][i],
+                     "bruise_margin": float(result.columns["bruise_margin"][i]),
+                     "bruised": float(result.columns["bruised"][i]),
+                     "bruise_volume": float(result.columns["bruise_volume"][i]),
+                     "peak_force": float(result.columns["peak_force"][i]),
+                     "status": "ok" if result.status[i] == 0 else result.messages.text(i)})
+    safe_table = {name: [value] * len(columns) for name, value in base.items()}
+    safe_table[key] = columns
+    safe, _ = safe_heights(safe_table, len(columns))
+    return key, columns, heights, rows, {str(c): float(h) for c, h in zip(columns, safe)}
+
+
+def cmd_safe_height(args) -> int:
+    from ..damage.heights import safe_height
+
+    kwargs = _without_velocity(args)
+    if "drop_height" in kwargs:
+        raise UsageError("argument --drop-height: safe-height finds the drop height; leave it out")
+    _check_outputs([("--map-csv", args.map_csv, "csv"), ("--plot", args.plot, "figure")])
+    if (args.map_csv or args.plot) and not args.map:
+        args.map = "surface"
+    report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
+    if args.map:
+        key, columns, heights, rows, safe = _risk_map(kwargs, args.map)
+        report["risk_map"] = {"by": key, "safe_height": safe}
+        if args.map_csv:
+            from ..outputs import atomic_write
+
+            def write(tmp):
+                with open(tmp, "w", encoding="utf-8") as handle:
+                    names = list(rows[0])
+                    handle.write(",".join(names) + "\n")
+                    for row in rows:
+                        handle.write(",".join(f"{row[name]:.10g}" if isinstance(row[name], float) else
+                                              str(row[name]) for name in names) + "\n")
+
+            _library_call(atomic_write, args.map_csv, write, "--map-csv")
+        if args.plot:
+            from ..plotting import save_figure
+            from ..plotting.damage import risk_map_figure
+
+            _library_call(save_figure, risk_map_figure(key, columns, heights, rows, safe, report["criterion"]),
+                          args.plot, "--plot")
+    if args.json:
+        print(dump_json(report))
+    else:
+        height = report["safe_height"]
+        shown = "inf" if math.isinf(height) else f"{height * 100:.4g} cm"
+        print(f"safe drop height {shown} (criterion {report['criterion']}): {report['message']}")
+        for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy"):
+            if name in report:
+                quantity = OUTPUTS[name]
+                print(f"  at that height: {quantity.label} = {quantity.display(report[name])}")
+        for name, value in report.get("sensitivity", {}).items():
+            print(f"  d ln h / d ln {name} = {value:.4g}")
+        if args.map:
+            print(f"safe height by {report['risk_map']['by']}:")
+            for column, value in report["risk_map"]["safe_height"].items():
+                print(f"  {column:>14}  {'inf' if math.isinf(value) else f'{value * 100:.4g} cm'}")
+        for what, path in (("risk map", args.map_csv), ("figure", args.plot)):
+            if path:
+                print(f"{what} written to {path}")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------------ line
+def cmd_line(args) -> int:
+    from .. import runs
+    from ..damage.line import audit, read_line
+    from ..distributions import parse_distribution
+    from .runs import _count
+
+    try:
+        points = read_line(args.line)
+    except ValueError as exc:
+        raise UsageError(f"argument LINE: {exc}") from None
+    criterion = args.criterion
+    if criterion in (None, "none"):
+        raise UsageError("argument --criterion: required for a line audit: pressure, shear or energy (the onset "
+                         "height changes by an order of magnitude between them)")
+    _check_outputs([("--plot", args.plot, "figure")])
+    rows = _count("-n/--rows", args.rows, 1, 10_000_000)
+    seed = _count("--seed", args.seed, 0)
+    distributions, constants = [], {}
+    for quantity in INPUTS.values():
+        spec = getattr(args, quantity.name, None)
+        if spec is None or quantity.name in ("criterion",):
+            continue
+        if quantity.name in ("velocity", "drop_height", "surface"):
+            raise UsageError(f"argument {quantity.option}: set by each transfer point of the line")
+        if not quantity.numeric:
+            constants[quantity.name] = spec
+            continue
+        try:
+            distributions.append((quantity.name, parse_distribution(spec, quantity.dimension, quantity.name)))
+        except ValueError as exc:
+            raise UsageError(f"argument {quantity.option}: {exc}") from None
+    source = runs.PopulationSource(tuple(distributions), (), rows, seed)
+    members, _ = source.inputs(0, rows, None)
+    members.pop("model", None)
+    report = _library_call(audit, points, members, rows, criterion, constants)
+    report["seed"] = seed
+    report["inputs"] = {name: dist.describe() for name, dist in distributions}
+    if args.plot:
+        from ..plotting import save_figure
+        from ..plotting.damage import line_figure
+
+        _library_call(save_figure, line_figure(report), args.plot, "--plot")
+    if args.json:
+        print(dump_json(report))
+    else:
+        print(f"line {args.line}: {rows} fruit, criterion {criterion}; bruised on the line "
+              f"{report['incidence'] * 100:.3g} %, mean bruise volume {report['mean_bruise_volume'] * 1e9:.4g} mm³")
+        print(f"{'transfer point':<22}{'h [cm]':>8}{'surface':>13}{'incidence':>11}{'BV [mm³]':>10}"
+              f"{'cum. inc.':>11}{'cum. BV':>10}{'F_max [N]':>11}")
+        for point in report["points"]:
+            surface = "fruit" if point["fruit_on_fruit"] else point["surface"]
+            print(f"{point['name'][:21]:<22}{point['drop_height'] * 100:>8.4g}{surface:>13}"
+                  f"{point['incidence'] * 100:>10.3g}%{point['mean_bruise_volume'] * 1e9:>10.4g}"
+                  f"{point['cumulative_incidence'] * 100:>10.3g}%{point['cumulative_bruise_volume'] * 1e9:>10.4g}"
+                  f"{point['mean_peak_force']:>11.4g}")
+        print(f"most harmful transfer point: {report['worst_point']}")
+        if args.plot:
+            print(f"figure written to {args.plot}")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ libraries
+def _library_listing(args, rows, kind: str) -> int:
+    if args.json:
+        print(dump_json(rows))
+        return 0
+    for row in rows:
+        print(f"{row['name']}: {row.get('description', '')}")
+        for key, value in row.items():
+            if isinstance(value, dict) and "value" in value:
+                unit = value.get("unit") or ""
+                mark = "" if value.get("confirmed", True) else "  (unconfirmed)"
+                print(f"  {key:<24}{value['value']!s:>12} {unit:<6} [{value.get('low')}, {value.get('high')}]"
+                      f"{mark}  {value.get('source', '')}")
+            elif key not in ("name", "description") and value not in (None, ""):
+                print(f"  {key:<24}{value}")
+    print(f"sources and notes: docs/library.md ({len(rows)} {kind})")
+    return 0
+
+
+def cmd_fruits(args) -> int:
+    from ..library import fruit_rows
+
+    return _library_listing(args, fruit_rows(), "fruits")
+
+
+def cmd_surfaces(args) -> int:
+    from ..library import surface_rows
+
+    return _library_listing(args, surface_rows(), "surfaces")
+
+
+def add_parsers(sub) -> None:
+    from ..quantities import INPUTS as TABLE
+
+    dr = sub.add_parser("drop", help="drop a fruit from a height: the rebounds until it rests, damage per impact",
+                        description="Drop a fruit from --drop-height onto a surface; every impact at its own "
+                                    "velocity, its restitution from the model.")
+    _add_impact_options(dr)
+    dr.add_argument("--max-impacts", default="50", metavar="N", help="impacts followed at most (default 50)")
+    dr.add_argument("--json", action="store_true", help="print one JSON object (SI)")
+    dr.set_defaults(func=cmd_drop)
+
+    sh = sub.add_parser("safe-height", help="the greatest drop height without bruise onset (root finding)",
+                        description="The greatest drop height without bruise onset for --criterion, by root "
+                                    "finding, with its sensitivity to firmness, mass and failure stress.")
+    _add_impact_options(sh)
+    sh.add_argument("--no-sensitivity", action="store_true", help="skip the sensitivities")
+    sh.add_argument("--map", choices=("surface", "firmness"), help="also a bruise-risk map: height × surface "
+                                                                   "or height × modulus")
+    sh.add_argument("--map-csv", metavar="FILE", help="write the risk map as CSV")
+    sh.add_argument("--plot", metavar="FILE", help="draw the risk map (PNG/SVG/PDF)")
+    sh.add_argument("--json", action="store_true", help="print one JSON object (SI)")
+    sh.set_defaults(func=cmd_safe_height)
+
+    ln = sub.add_parser("line", help="packing-line audit: bruise incidence at each transfer point",
+                        description="Pass a population of fruit through the transfer points of LINE "
+                                    "(CSV: name,drop_height,surface[,fruit_on_fruit]).")
+    ln.add_argument("line", metavar="LINE", help="the line's transfer points, CSV")
+    group = ln.add_argument_group("population (numbers, or normal(m,sd), lognormal(m,cv), uniform(a,b), ...)")
+    for quantity in TABLE.values():
+        if quantity.option and quantity.name not in ("velocity", "drop_height", "surface"):
+            group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
+                               help=quantity.doc)
+    group.add_argument("-n", "--rows", default="10000", metavar="N", help="fruit in the population (default 10000)")
+    group.add_argument("--seed", default="0", metavar="S", help="random seed (default 0)")
+    ln.add_argument("--plot", metavar="FILE", help="incidence and bruise volume along the line (PNG/SVG/PDF)")
+    ln.add_argument("--json", action="store_true", help="print one JSON object (SI)")
+    ln.set_defaults(func=cmd_line)
+
+    for name, func, text in (("fruits", cmd_fruits, "the fruit library, with sources"),
+                             ("surfaces", cmd_surfaces, "the surface library, with sources")):
+        parser = sub.add_parser(name, help=text, description=f"List {text}.")
+        parser.add_argument("--json", action="store_true", help="print JSON")
+        parser.set_defaults(func=func)

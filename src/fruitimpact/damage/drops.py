@@ -1,0 +1,169 @@
+"""Drops: a fruit let fall from a height bounces on a surface until it rests.
+
+Each impact is a full impact of ``batch.evaluate`` at its own velocity, the
+restitution following from the model at that velocity (with plastic contact
+it falls as the velocity rises).  The rebound speed of one impact is the
+impact speed of the next, V_{n+1} = e_n V_n (no drag), after a flight of
+2 V_{n+1}/g.
+
+How repeated impacts on the same spot accumulate damage (the rule, stated in
+every output and in docs/damage.md): the fruit lands on the same spot every
+time.  Under Thornton's law a re-impact at V ≤ e V reloads the flattened spot
+elastically along the unloading curve, Hertz with the enlarged radius R_p
+(TN98 eq 20), up to at most the largest force already reached: so the later
+bounces add viscous work but no plastic work, and their pressure is lower
+than the first impact's.  Each impact that meets the bruise criterion adds
+BS (W_f − W_th)₊ to the bruise volume.  Measured apple bruises keep growing over
+3–5 repeated equal impacts before they stabilise (Komarnicki & Stopa 2013;
+the pendulum studies of docs/damage.md): this rule does not reproduce that
+growth; in a drop the later bounces carry much less energy, which limits the
+difference.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..constants import STANDARD_GRAVITY
+
+#: Impacts followed at most.
+MAX_IMPACTS = 50
+#: The fruit is at rest once a rebound would rise less than this [m].
+REST_HEIGHT = 1e-3
+#: Accumulation rule, named in every output.
+ACCUMULATION_RULE = ("same spot; later impacts reload the flattened spot elastically along Thornton's unloading "
+                     "curve (no new plastic work); each impact meeting the criterion adds BS (W_f - W_th)+")
+
+_IMPACT_FIELDS = ("velocity", "restitution", "exit_velocity", "peak_force", "time_to_peak", "contact_duration",
+                  "max_deflection", "max_pressure", "max_shear_stress", "absorbed_energy", "plastic_work",
+                  "viscous_work", "fruit_energy", "permanent_deflection", "bruise_margin", "bruised", "bruise_volume",
+                  "bruise_depth", "bruise_width")
+
+
+def evaluation_of(inputs, messages):
+    from ..batch import evaluate_inputs
+
+    return evaluate_inputs(inputs, messages, detail=True)
+
+
+def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = REST_HEIGHT, **inputs) -> dict:
+    """The sequence of impacts of a fruit dropped from ``drop_height`` [m] onto a surface.
+
+    Parameters
+    ----------
+    drop_height : float or str
+        Height of the fall h > 0 [m] (or a string with a unit); V_1 = √(2 g h).
+    max_impacts : int
+        Impacts followed at most.
+    rest_height : float
+        The fruit rests once a rebound would rise less than this [m].
+    **inputs
+        Any input of ``quantities.INPUTS`` but the velocity (fruit, surface, model,
+        plastic and bruise inputs), as for ``simulate``.
+
+    Returns
+    -------
+    dict
+        ``drop_height``, ``criterion``, ``accumulation_rule``, ``impacts`` (one dict per
+        impact: ``velocity``, ``restitution``, ``peak_force``, ``plastic_work`` …, ``time``
+        of the impact [s] after release), and the totals ``impact_count``,
+        ``total_absorbed_energy``, ``total_plastic_work``, ``total_viscous_work``,
+        ``bruised`` (any impact), ``bruise_volume`` (accumulated), ``rest_time``,
+        ``status`` and ``message``, ``warnings``.
+    """
+    from ..inputs import read_columns
+    from ..quantities import INPUTS
+    from ..validation import InputError
+
+    for name in ("velocity", "drop_height"):
+        if name in inputs:
+            raise InputError(f"{name} is set by the drop: give drop_height as the first argument", name)
+    unknown = [name for name in inputs if name not in INPUTS]
+    if unknown:
+        raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
+    if not (isinstance(max_impacts, int) and 1 <= max_impacts <= 1000):
+        raise InputError(f"max_impacts must be an integer in [1, 1000]; got {max_impacts!r}", "max_impacts")
+    if inputs.get("surface") == "fruit":
+        raise InputError("surface fruit is a free partner: a drop bounces on a fixed surface (simulate the "
+                         "fruit-on-fruit impact itself with --surface fruit)", "surface")
+    row = {name: value for name, value in inputs.items() if value is not None}
+    row["drop_height"] = drop_height
+    read, messages = read_columns({name: [value] for name, value in row.items()})
+    first = evaluation_of(read, messages)
+    if first.status[0] == 3:  # invalid: the one-line refusal, naming the argument
+        raise InputError(messages.text(0), messages.argument(0))
+    height = float(first.columns["drop_height"][0])
+    criterion = first.columns["criterion"][0]
+    impacts = []
+    warnings = list(first.warnings.row(0))
+    status, message = "ok", "ok"
+    velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
+    time = math.sqrt(2.0 * height / STANDARD_GRAVITY)
+    result = first
+    flattened = None
+    while True:
+        columns = {name: (float(result.columns[name][0])) for name in _IMPACT_FIELDS}
+        code = int(result.status[0])
+        impact = {"impact": len(impacts) + 1, "time": time, **columns}
+        impact["bruised"] = None if math.isnan(columns["bruised"]) else bool(columns["bruised"])
+        impacts.append(impact)
+        if code != 0:
+            status = "failed" if code == 2 else "inaccurate"
+            message = f"impact {len(impacts)}: {result.messages.text(0)}"
+            break
+        if flattened is None and result.plastic_block is not None and result.plastic[0]:
+            radius_p = float(result.plastic_block[0, -1])
+            if columns["permanent_deflection"] > 0.0:
+                flattened = radius_p
+        rebound = columns["exit_velocity"]
+        if rebound * rebound / (2.0 * STANDARD_GRAVITY) < rest_height or len(impacts) >= max_impacts:
+            if len(impacts) >= max_impacts and rebound * rebound / (2.0 * STANDARD_GRAVITY) >= rest_height:
+                warnings.append(f"stopped after {max_impacts} impacts while the fruit still rebounds "
+                                f"{rebound * rebound / (2.0 * STANDARD_GRAVITY) * 1e3:.3g} mm")
+            break
+        time += contact(columns) + 2.0 * rebound / STANDARD_GRAVITY
+        velocity = rebound
+        next_row = {**row, "velocity": velocity}
+        next_row.pop("drop_height")
+        if flattened is not None:
+            # the same, flattened spot: Hertz with R_p (same E*), elastic up to the force already reached
+            next_row.pop("yield_pressure", None)
+            next_row.pop("bioyield_force", None)
+            next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
+            next_row["diameter"] = 2.0 * flattened
+        read, messages = read_columns({name: [value] for name, value in next_row.items()})
+        result = evaluation_of(read, messages)
+        if result.status[0] == 3:
+            status, message = "failed", f"impact {len(impacts) + 1}: {messages.text(0)}"
+            break
+        for text in result.warnings.row(0):
+            if text not in warnings and not text.startswith("diameter"):
+                warnings.append(text)
+    rest = impacts[-1]["time"] + impacts[-1]["contact_duration"]
+    volumes = [i["bruise_volume"] for i in impacts]
+    bruised = [i["bruised"] for i in impacts]
+    return {
+        "drop_height": height, "criterion": criterion, "accumulation_rule": ACCUMULATION_RULE,
+        "impacts": impacts, "impact_count": len(impacts),
+        "total_absorbed_energy": float(sum(i["absorbed_energy"] for i in impacts)),
+        "total_plastic_work": float(sum(i["plastic_work"] for i in impacts)),
+        "total_viscous_work": float(sum(i["viscous_work"] for i in impacts)),
+        "total_fruit_energy": float(sum(i["fruit_energy"] for i in impacts)),
+        "energy_left": 0.5 * float(first.columns["mass"][0]) * impacts[-1]["exit_velocity"] ** 2,
+        "bruised": None if criterion == "none" else any(bool(b) for b in bruised),
+        "bruise_volume": None if criterion == "none" else float(np.nansum(volumes)),
+        "rest_time": rest, "status": status, "message": message, "warnings": warnings,
+    }
+
+
+def contact(columns: dict) -> float:
+    return columns["contact_duration"]
+
+
+def _contact_modulus(evaluation) -> float:
+    return float(evaluation.kernel_arguments["contact_modulus"][0])
+
+
+__all__ = ["ACCUMULATION_RULE", "MAX_IMPACTS", "REST_HEIGHT", "drop"]

@@ -1,0 +1,170 @@
+"""Safe drop heights: the greatest height from which the fruit does not bruise, by root finding.
+
+The bruise margin of an impact (``bruise_margin``: the criterion's stress or
+energy over its threshold, minus 1) rises with the drop height; the safe drop
+height is its root, found on the logarithm of the height by the Illinois
+variant of regula falsi (bracketed, superlinear) on all rows of a table at
+once: every iteration is one ``batch.evaluate`` of the table.  It is a root,
+not a scan: to a relative tolerance of 1e-9 in h.
+
+Checked (tests/test_heights.py) against the closed form of elastic Hertz on a
+rigid flat, h = π⁴ p⁵ / (80 g ρ E*⁴) (p = σ_f for the pressure criterion,
+p = σ_f p_0/Y(ν) for the shear criterion): independent of the fruit's size,
+with d ln h/d ln E = −4 and d ln h/d ln σ_f = 5.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..constants import STANDARD_GRAVITY
+
+#: The heights searched [m]: below the lowest the fruit bruises "from any height", above the highest never.
+LOWEST, HIGHEST = 1e-5, 10.0
+#: Relative tolerance of the root.
+TOLERANCE = 1e-9
+#: Relative step of the sensitivities (central differences; h is a smooth power of each input).
+SENSITIVITY_STEP = 0.01
+#: The inputs whose elasticity d ln h / d ln x is reported, by criterion.
+SENSITIVITY_INPUTS = {"pressure": ("modulus", "mass", "failure_stress"),
+                      "shear": ("modulus", "mass", "failure_stress"),
+                      "energy": ("modulus", "mass", "bruise_energy")}
+
+
+def _margins(table: dict, heights: np.ndarray):
+    from ..batch import evaluation
+
+    result = evaluation({**table, "drop_height": heights})
+    return np.asarray(result.columns["bruise_margin"], dtype=float), result
+
+
+def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
+    """Safe drop height [m] of every row of ``table`` (columns of inputs, ``rows`` long, with a
+    ``criterion``; no velocity or drop height), and a message per row ("ok", or why not).
+
+    A row that bruises even from ``LOWEST`` gets 0, one that does not bruise from ``HIGHEST``
+    gets inf, an invalid row NaN (its message says why)."""
+    low = np.full(rows, math.log(LOWEST))
+    high = np.full(rows, math.log(HIGHEST))
+    f_low, first = _margins(table, np.exp(low))
+    f_high, last = _margins(table, np.exp(high))
+    messages = ["ok"] * rows
+    heights = np.full(rows, np.nan)
+    status = first.status
+    active = np.ones(rows, dtype=bool)
+    for i in range(rows):
+        if status[i] != 0 or last.status[i] != 0 or math.isnan(f_low[i]) or math.isnan(f_high[i]):
+            text = first.messages.text(i) if status[i] != 0 else last.messages.text(i)
+            messages[i] = text if text and text != "ok" else "no bruise margin: give a criterion (pressure, shear, energy)"
+            active[i] = False
+        elif f_low[i] >= 0.0:
+            heights[i], messages[i] = 0.0, f"bruises from any height: already at {LOWEST * 1e3:g} mm"
+            active[i] = False
+        elif f_high[i] < 0.0:
+            heights[i], messages[i] = math.inf, f"no bruise up to {HIGHEST:g} m"
+            active[i] = False
+    side = np.zeros(rows, dtype=np.int8)
+    for _ in range(200):
+        if not active.any():
+            break
+        x = np.where(active, high - f_high * (high - low) / (f_high - f_low), 0.5 * (low + high))
+        bad = ~((x > low) & (x < high))
+        x[bad] = 0.5 * (low[bad] + high[bad])
+        f_x, _ = _margins(table, np.exp(x))
+        above = f_x >= 0.0
+        # Illinois: halve the retained end's value when the same end is kept twice
+        keep_low = active & above
+        keep_high = active & ~above
+        f_low = np.where(keep_low & (side == -1), 0.5 * f_low, f_low)
+        f_high = np.where(keep_high & (side == 1), 0.5 * f_high, f_high)
+        high = np.where(keep_low, x, high)
+        f_high = np.where(keep_low, f_x, f_high)
+        low = np.where(keep_high, x, low)
+        f_low = np.where(keep_high, f_x, f_low)
+        side = np.where(keep_low, -1, np.where(keep_high, 1, side)).astype(np.int8)
+        active &= (high - low) > TOLERANCE
+    done = np.isnan(heights) & np.isfinite(low) & np.array([m == "ok" for m in messages])
+    heights[done] = np.exp(0.5 * (low[done] + high[done]))
+    return heights, messages
+
+
+def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
+    """The safe drop height of one fruit on one surface [m], with its sensitivities.
+
+    Parameters
+    ----------
+    sensitivity : bool
+        Also compute the elasticities d ln h / d ln x of the modulus, the mass and the
+        failure stress (or threshold energy), by central differences of ±1 %.
+    **inputs
+        Inputs of ``quantities.INPUTS`` (not the velocity or drop height), with a
+        ``criterion`` (``pressure``, ``shear`` or ``energy``).
+
+    Returns
+    -------
+    dict
+        ``safe_height`` [m] (0: bruises from any height; inf: none up to 10 m),
+        ``safe_velocity`` [m/s], ``criterion``, ``message``, ``sensitivity`` (name →
+        elasticity), and the bruise figures at that height.
+    """
+    from ..quantities import INPUTS
+    from ..validation import InputError
+
+    for name in ("velocity", "drop_height"):
+        if inputs.get(name) is not None:
+            raise InputError(f"{name} is what safe-height finds: leave it out", name)
+    unknown = [name for name in inputs if name not in INPUTS]
+    if unknown:
+        raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
+    criterion = inputs.get("criterion")
+    if criterion in (None, "none"):
+        raise InputError("criterion must be given for a safe height: pressure, shear or energy (the onset height "
+                         "changes by an order of magnitude between them)", "criterion")
+    given = {name: value for name, value in inputs.items() if value is not None}
+    _check_row(given)
+    names = SENSITIVITY_INPUTS.get(criterion, ())
+    cases = [given]
+    if sensitivity:
+        from ..batch import evaluation
+
+        base = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
+        for name in names:
+            value = float(base.columns[name][0])
+            for factor in (1.0 + SENSITIVITY_STEP, 1.0 - SENSITIVITY_STEP):
+                cases.append({**given, name: value * factor})
+    table = {name: [case.get(name) for case in cases] for name in set().union(*cases)}
+    heights, messages = safe_heights(table, len(cases))
+    height = float(heights[0])
+    report = {"safe_height": height, "safe_velocity": math.sqrt(2.0 * STANDARD_GRAVITY * height)
+              if math.isfinite(height) else height, "criterion": criterion, "message": messages[0]}
+    if sensitivity:
+        report["sensitivity"] = {}
+        for k, name in enumerate(names):
+            up, down = heights[1 + 2 * k], heights[2 + 2 * k]
+            ok = all(math.isfinite(v) and v > 0 for v in (up, down))
+            report["sensitivity"][name] = (math.log(up / down) / math.log((1 + SENSITIVITY_STEP) /
+                                                                         (1 - SENSITIVITY_STEP)) if ok else math.nan)
+    if math.isfinite(height) and height > 0:
+        from ..batch import evaluation
+
+        at = evaluation({name: [value] for name, value in {**given, "drop_height": height}.items()})
+        for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy", "absorbed_energy",
+                     "restitution", "failure_stress", "bruise_energy"):
+            report[name] = float(at.columns[name][0])
+    return report
+
+
+def _check_row(given: dict) -> None:
+    """Refuse bad inputs before the search, with the table's message."""
+    from ..batch import evaluation
+    from ..status import INVALID
+    from ..validation import InputError
+
+    probe = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
+    if probe.status[0] == INVALID:
+        raise InputError(probe.messages.text(0), probe.messages.argument(0))
+
+
+__all__ = ["HIGHEST", "LOWEST", "SENSITIVITY_INPUTS", "safe_height", "safe_heights"]

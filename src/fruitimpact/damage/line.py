@@ -1,0 +1,145 @@
+"""Packing-line audit: a population of fruit through a sequence of transfer points.
+
+A line is a table of transfer points, in the order the fruit meets them:
+``name``, ``drop_height`` [m] (or with a unit), ``surface`` (a library surface)
+and optionally ``fruit_on_fruit`` (true: the fruit lands on another fruit
+resting there, an identical free fruit; the approach speed is that of the
+drop).  Every member of the population meets every point once; the impacts
+at different points land on different spots of the fruit (independent
+impacts: bruise volumes add, a fruit is bruised on the line if it is bruised
+at any point).  Per point: the bruise incidence (fraction of the fruit the
+criterion calls bruised there), the mean bruise volume per fruit, the mean
+peak force; cumulated along the line: the incidence of fruit bruised at least
+once so far and the mean accumulated bruise volume.  The point that bruises
+the most fruit (ties: the larger mean bruise volume) is named.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Columns of a line table; ``fruit_on_fruit`` is optional.
+LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit")
+_TRUE, _FALSE = {"true", "yes", "1", "y"}, {"false", "no", "0", "n", ""}
+#: Transfer points of a line at most.
+MAX_POINTS = 200
+
+
+@dataclass(frozen=True)
+class TransferPoint:
+    """One transfer point: where the fruit drops ``drop_height`` [m] onto ``surface``."""
+
+    name: str
+    drop_height: float
+    surface: str
+    fruit_on_fruit: bool = False
+
+
+def read_line(path) -> list[TransferPoint]:
+    """The transfer points of a line CSV (header ``name,drop_height,surface[,fruit_on_fruit]``;
+    ``#`` comment lines allowed).  ``ValueError`` naming the line and the column of the first problem:
+    unknown or missing columns, ragged rows, unknown surfaces, heights that are not positive."""
+    import csv
+
+    from ..registries import SURFACE_CHOICES
+    from ..units import parse_quantity
+
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"cannot read {path}: not a UTF-8 text file") from None
+    rows = list(csv.reader(lines))
+    if not rows:
+        raise ValueError(f"{path} is empty: expected a header {','.join(LINE_COLUMNS)}")
+    header = [cell.strip().replace("-", "_") for cell in rows[0]]
+    unknown = [cell for cell in header if cell not in LINE_COLUMNS]
+    if unknown:
+        raise ValueError(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (columns: "
+                         f"{', '.join(LINE_COLUMNS)})")
+    missing = [name for name in LINE_COLUMNS[:3] if name not in header]
+    if missing:
+        raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
+    if len(rows) < 2:
+        raise ValueError(f"{path}: no transfer points below the header")
+    if len(rows) - 1 > MAX_POINTS:
+        raise ValueError(f"{path}: {len(rows) - 1} transfer points; at most {MAX_POINTS}")
+    points = []
+    for number, row in enumerate(rows[1:], start=2):
+        where = f"{path}, line {number}"
+        if len(row) != len(header):
+            raise ValueError(f"{where}: {len(row)} fields, the header has {len(header)}")
+        cells = dict(zip(header, (cell.strip() for cell in row)))
+        if not cells["name"]:
+            raise ValueError(f"{where}: name is empty")
+        try:
+            height = parse_quantity(cells["drop_height"], "length")
+        except ValueError as exc:
+            raise ValueError(f"{where}: drop_height: {exc}") from None
+        if not (math.isfinite(height) and 0.0 < height <= 10.0):
+            raise ValueError(f"{where}: drop_height must be in (0, 10] m; got {cells['drop_height']!r}")
+        surface = cells["surface"]
+        if surface not in SURFACE_CHOICES or surface == "fruit":
+            raise ValueError(f"{where}: surface must be one of "
+                             f"{', '.join(s for s in SURFACE_CHOICES if s != 'fruit')}; got {surface!r} "
+                             f"(fruit on fruit: set fruit_on_fruit to true)")
+        flag = cells.get("fruit_on_fruit", "").lower()
+        if flag not in _TRUE | _FALSE:
+            raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
+        points.append(TransferPoint(cells["name"], height, surface, flag in _TRUE))
+    return points
+
+
+def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str, constants: dict) -> dict:
+    """Pass ``rows`` fruit (``members``: input columns of the population) through ``points``.
+
+    ``constants``: inputs shared by all (criterion inputs, model …).  Returns a dict with
+    ``points`` (one dict per transfer point: ``name``, ``drop_height``, ``surface``,
+    ``fruit_on_fruit``, ``velocity``, ``incidence``, ``mean_bruise_volume``, ``mean_peak_force``,
+    ``mean_max_pressure``, ``cumulative_incidence``, ``cumulative_bruise_volume``, ``invalid``,
+    ``failed``), ``worst_point``, ``incidence`` (on the whole line), ``mean_bruise_volume``
+    and ``criterion``."""
+    from ..batch import evaluation
+    from ..constants import STANDARD_GRAVITY
+    from ..validation import InputError
+
+    bruised_any = np.zeros(rows, dtype=bool)
+    volume_total = np.zeros(rows)
+    report = []
+    for point in points:
+        table = {**members, **constants, "drop_height": np.full(rows, point.drop_height),
+                 "surface": "fruit" if point.fruit_on_fruit else point.surface, "criterion": criterion}
+        result = evaluation(table)
+        status = result.status
+        ok = status == 0
+        if not ok.any() and (status == 3).all():
+            raise InputError(f"transfer point {point.name!r}: {result.messages.text(0)}",
+                             result.messages.argument(0))
+        bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
+        volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
+        bruised_any |= bruised
+        volume_total += volume
+        count = max(int(ok.sum()), 1)
+        report.append({
+            "name": point.name, "drop_height": point.drop_height, "surface": point.surface,
+            "fruit_on_fruit": point.fruit_on_fruit,
+            "velocity": math.sqrt(2.0 * STANDARD_GRAVITY * point.drop_height),
+            "incidence": float(bruised[ok].sum() / count),
+            "mean_bruise_volume": float(volume[ok].sum() / count),
+            "mean_peak_force": float(np.mean(result.columns["peak_force"][ok])) if ok.any() else math.nan,
+            "mean_max_pressure": float(np.mean(result.columns["max_pressure"][ok])) if ok.any() else math.nan,
+            "cumulative_incidence": float(bruised_any.mean()),
+            "cumulative_bruise_volume": float(volume_total.mean()),
+            "invalid": int((status == 3).sum()), "failed": int((status == 2).sum()),
+        })
+    worst = max(range(len(report)), key=lambda i: (report[i]["incidence"], report[i]["mean_bruise_volume"]))
+    return {"criterion": criterion, "fruit": rows, "points": report, "worst_point": report[worst]["name"],
+            "incidence": float(bruised_any.mean()), "mean_bruise_volume": float(volume_total.mean())}
+
+
+__all__ = ["LINE_COLUMNS", "MAX_POINTS", "TransferPoint", "audit", "read_line"]
