@@ -1,0 +1,204 @@
+"""Damage commands: drops, safe heights, line audits, their contracts and refusals (issue 7).
+
+Independent references: the closed-form onset height of elastic Hertz on a rigid flat,
+h = π⁴ p⁵ / (80 g ρ E*⁴) (p = σ_f for the pressure criterion, p = σ_f p_0/Y(ν) for the
+shear criterion, derived from ½ m V² = (2/5) F δ and p_0 = (2E*/π) √(δ/R)), written out
+here; energy conservation over a drop; the batch evaluation of the same members for a line.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fruitimpact import batch
+from fruitimpact.damage.drops import drop
+from fruitimpact.damage.heights import safe_height
+from fruitimpact.damage.line import TransferPoint, audit, read_line
+
+G = 9.80665
+APPLE = dict(mass=0.115, diameter=0.065, modulus=3e6, poisson=0.37)
+
+
+def _onset_height(pressure, mass, diameter, modulus, poisson):
+    """π⁴ p⁵/(80 g ρ E*⁴): the height at which an undamped Hertz impact's centre pressure reaches p."""
+    density = mass / (math.pi * diameter ** 3 / 6.0)
+    contact_modulus = modulus / (1.0 - poisson ** 2)
+    return math.pi ** 4 * pressure ** 5 / (80.0 * G * density * contact_modulus ** 4)
+
+
+def _tau_factor(poisson):
+    """τ_max/p_0 on the Hertz axis by a fine grid of Johnson's eq 3.45 (a method unlike the module's Newton)."""
+    z = np.linspace(1e-4, 3.0, 300001)
+    sigma_z = -1.0 / (1.0 + z * z)
+    sigma_r = -(1.0 + poisson) * (1.0 - z * np.arctan(1.0 / z)) + 0.5 / (1.0 + z * z)
+    return float(np.max(0.5 * np.abs(sigma_z - sigma_r)))
+
+
+@pytest.mark.parametrize("criterion", ["pressure", "shear"])
+def test_safe_height_of_undamped_hertz_is_the_closed_form(criterion):
+    # the root is found to 1e-9 in h; the grid maximum of τ/p0 is exact to ~1e-10 (spacing 1e-5, quadratic peak)
+    result = safe_height(criterion=criterion, model="hertz", failure_stress=3e5, **APPLE)
+    pressure = 3e5 if criterion == "pressure" else 3e5 / (2.0 * _tau_factor(0.37))
+    expected = _onset_height(pressure, **APPLE)
+    assert result["safe_height"] == pytest.approx(expected, rel=1e-8)
+    # h ∝ σ⁵ E*⁻⁴ ρ⁻¹: at a fixed diameter the mass is the density (elasticity −1), not the size (0)
+    assert result["sensitivity"]["modulus"] == pytest.approx(-4.0, abs=1e-6)
+    assert result["sensitivity"]["failure_stress"] == pytest.approx(5.0, abs=1e-6)
+    assert result["sensitivity"]["mass"] == pytest.approx(-1.0, abs=1e-6)
+
+
+def test_safe_height_does_not_depend_on_fruit_size_at_fixed_density():
+    density = APPLE["mass"] / (math.pi * APPLE["diameter"] ** 3 / 6.0)
+    heights = [safe_height(criterion="pressure", model="hertz", failure_stress=3e5, sensitivity=False,
+                           diameter=d, mass=density * math.pi * d ** 3 / 6.0, modulus=3e6, poisson=0.37)["safe_height"]
+               for d in (0.04, 0.065, 0.09)]
+    assert heights[0] == pytest.approx(heights[1], rel=1e-8) == pytest.approx(heights[2], rel=1e-8)
+
+
+def test_safe_height_ordered_by_surface():
+    """Acceptance: steel ≤ wood < rubber belt < foam pad (the hard surfaces are rigid for Hertz)."""
+    heights = {s: safe_height(criterion="shear", surface=s, sensitivity=False)["safe_height"]
+               for s in ("steel", "wood", "rubber-belt", "foam-pad")}
+    assert heights["steel"] <= heights["wood"] < heights["rubber-belt"] < heights["foam-pad"]
+    assert heights["wood"] / heights["steel"] - 1 < 0.05  # wood across the grain: ~1 % softer contact
+
+
+def test_safe_height_edges_are_said():
+    never = safe_height(criterion="energy", bruise_energy=100.0, sensitivity=False)
+    assert never["safe_height"] == math.inf and "no bruise up to" in never["message"]
+    with pytest.raises(ValueError, match="criterion must be given"):
+        safe_height()
+    with pytest.raises(ValueError, match="drop_height is what safe-height finds"):
+        safe_height(criterion="shear", drop_height=0.1)
+
+
+def test_drop_energy_is_conserved_and_plastic_work_only_on_the_first_impact():
+    report = drop(0.1, yield_pressure=3e5, criterion="shear")
+    impacts = report["impacts"]
+    mass = 0.115
+    # everything the fruit had at release is absorbed by the impacts or still in the last rebound
+    released = mass * G * 0.1
+    assert report["total_absorbed_energy"] + report["energy_left"] == pytest.approx(released, rel=1e-9)
+    for before, after in zip(impacts, impacts[1:]):
+        assert after["velocity"] == pytest.approx(before["restitution"] * before["velocity"], rel=1e-12)
+    assert impacts[0]["plastic_work"] > 0.0
+    assert all(i["plastic_work"] == 0.0 for i in impacts[1:])  # the same spot reloads elastically (Thornton)
+    assert impacts[0]["velocity"] == pytest.approx(math.sqrt(2 * G * 0.1), rel=1e-12)
+    # the rebound height of the last impact is below the rest height (1 mm)
+    assert impacts[-1]["exit_velocity"] ** 2 / (2 * G) < 1e-3
+    assert report["bruise_volume"] == pytest.approx(sum(i["bruise_volume"] for i in impacts), rel=1e-12)
+
+
+def test_drop_refuses_a_free_partner_and_a_velocity():
+    with pytest.raises(ValueError, match="surface fruit is a free partner"):
+        drop(0.1, surface="fruit")
+    with pytest.raises(ValueError, match="velocity is set by the drop"):
+        drop(0.1, velocity=2.0)
+
+
+def test_line_incidence_is_the_batch_bruise_rate_of_the_same_members(tmp_path):
+    rng = np.random.default_rng(3)
+    rows = 400
+    members = {"mass": rng.normal(0.15, 0.02, rows), "modulus": rng.lognormal(np.log(3e6), 0.2, rows)}
+    points = [TransferPoint("a", 0.02, "pvc-belt"), TransferPoint("b", 0.3, "foam-pad"),
+              TransferPoint("c", 0.05, "steel", fruit_on_fruit=True)]
+    report = audit(points, members, rows, "shear", {})
+    bruised_any = np.zeros(rows, dtype=bool)
+    for point, row in zip(points, report["points"]):
+        frame = batch.evaluate({**members, "drop_height": np.full(rows, point.drop_height),
+                                "surface": "fruit" if point.fruit_on_fruit else point.surface, "criterion": "shear"})
+        bruised = frame["bruised"].to_numpy() > 0.5
+        bruised_any |= bruised
+        assert row["incidence"] == pytest.approx(bruised.mean(), abs=1e-12)
+        assert row["mean_bruise_volume"] == pytest.approx(frame["bruise_volume"].mean(), rel=1e-12)
+        assert row["cumulative_incidence"] == pytest.approx(bruised_any.mean(), abs=1e-12)
+    worst = max(report["points"], key=lambda p: (p["incidence"], p["mean_bruise_volume"]))
+    assert report["worst_point"] == worst["name"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ("name,drop_height,surface\na,10cm,granite\n", "surface must be one of"),
+    ("name,drop_height,surface\na,-10cm,steel\n", "drop_height must be in (0, 10] m"),
+    ("name,drop_height,surface\na,10cm,steel,extra\n", "4 fields, the header has 3"),
+    ("name,height,surface\na,10cm,steel\n", "unknown column(s) 'height'"),
+    ("name,drop_height\na,10cm\n", "missing column(s) surface"),
+    ("name,drop_height,surface,fruit_on_fruit\na,10cm,steel,maybe\n", "fruit_on_fruit must be true or false"),
+    ("name,drop_height,surface\na,nan,steel\n", "drop_height must be in (0, 10] m"),
+])
+def test_bad_lines_are_refused_with_their_line_number(tmp_path, text, message):
+    path = tmp_path / "line.csv"
+    path.write_text(text)
+    with pytest.raises(ValueError) as info:
+        read_line(path)
+    assert message in str(info.value)
+
+
+# ---------------------------------------------------------------------------- CLI contract (issue 7)
+SIMULATE_KEYS = ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work", "max_shear_stress",
+                 "bruised", "bruise_volume", "bruise_depth", "bruise_width", "criterion")
+
+
+def test_simulate_json_has_the_damage_keys(cli):
+    report = cli.json("simulate", "--fruit", "apple", "--surface", "steel", "--yield-pressure", "0.3MPa",
+                      "--failure-stress", "0.3MPa", "--criterion", "shear", "--drop-height", "10cm")
+    assert set(SIMULATE_KEYS) <= set(report)
+    assert report["criterion"] == "shear" and report["bruised"] is True
+    assert report["plastic_work"] + report["viscous_work"] == pytest.approx(report["absorbed_energy"], rel=1e-9)
+    pure = cli.json("simulate", "--model", "hertz", "--yield-pressure", "0.3MPa", "--velocity", "1")
+    assert pure["viscous_work"] == pytest.approx(0.0, abs=1e-12 * pure["absorbed_energy"])  # pure Thornton
+    for surface in ("steel", "concrete", "wood", "pvc-belt", "rubber-belt", "foam-pad", "cardboard", "fruit"):
+        assert cli.json("simulate", "--surface", surface)["surface"] == surface
+
+
+def test_drop_and_safe_height_json_contracts(cli):
+    report = cli.json("drop", "--drop-height", "10cm", "--yield-pressure", "0.3MPa", "--criterion", "pressure")
+    assert isinstance(report["impacts"], list) and report["impacts"]
+    for key in ("velocity", "restitution", "peak_force", "plastic_work"):
+        assert key in report["impacts"][0]
+    safe = cli.json("safe-height", "--criterion", "pressure", "--model", "hertz", "--failure-stress", "0.3MPa")
+    assert safe["criterion"] == "pressure"
+    assert safe["safe_height"] == pytest.approx(_onset_height(3e5, **APPLE), rel=1e-8)
+
+
+def test_runs_accept_the_damage_inputs(cli, tmp_path):
+    table = tmp_path / "in.csv"
+    table.write_text("drop_height,surface,yield_pressure,criterion,failure_stress\n"
+                     "10cm,steel,0.3MPa,shear,0.3MPa\n5cm,foam-pad,,pressure,\n")
+    out = tmp_path / "out.csv"
+    cli.ok("batch", table, "-o", out)
+    import csv
+
+    with open(out) as handle:
+        rows = list(csv.DictReader(handle))
+    assert rows[0]["criterion"] == "shear" and float(rows[0]["plastic_work"]) > 0
+    assert rows[1]["surface"] == "foam-pad" and rows[1]["status"] == "ok"
+    cli.ok("sweep", "--drop-height", "1cm:30cm:3", "--surface", "rubber-belt", "--criterion", "shear",
+           "-o", tmp_path / "sweep.csv")
+    summary = cli.json("population", "-n", "500", "--drop-height", "uniform(1cm,20cm)", "--criterion", "shear",
+                       "--yield-pressure", "0.3MPa", "--characteristics", "bruised,bruise_volume")
+    assert 0.0 < summary["statistics"]["bruised"]["mean"] <= 1.0  # the probability of bruising
+
+
+@pytest.mark.parametrize("argv, option", [
+    (("simulate", "--fruit", "banana"), "--fruit"),
+    (("simulate", "--surface", "granite"), "--surface"),
+    (("drop", "--drop-height", "-10cm"), "--drop-height"),
+    (("simulate", "--surface", "foam-pad", "--surface-thickness", "0.2mm"), "--surface-thickness"),
+    (("simulate", "--yield-pressure", "0"), "--yield-pressure"),
+    (("simulate", "--yield-pressure", "-1MPa"), "--yield-pressure"),
+    (("simulate", "--failure-stress", "0.3MPa"), "--failure-stress"),
+    (("simulate", "--criterion", "energy"), "--bruise-energy"),
+    (("simulate", "--criterion", "pain"), "--criterion"),
+    (("simulate", "--yield-pressure", "1MPa", "--bioyield-force", "20N"), "--yield-pressure"),
+    (("safe-height",), "--criterion"),
+    (("safe-height", "--criterion", "shear", "--drop-height", "1m"), "--drop-height"),
+    (("drop", "--drop-height", "10cm", "--surface", "fruit"), "--surface"),
+    (("simulate", "--model", "tsuji", "--yield-pressure", "1MPa"), "--yield-pressure"),
+    (("simulate", "--method", "rk4", "--yield-pressure", "1MPa"), "--method"),
+])
+def test_bad_damage_inputs_are_one_line_errors(cli, argv, option):
+    line = cli.error(*argv)
+    assert option in line, line
