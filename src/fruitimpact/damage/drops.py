@@ -138,8 +138,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         if result.status[0] == 3:
             status, message = "failed", f"impact {len(impacts) + 1}: {messages.text(0)}"
             break
-        for text in result.warnings.row(0):
-            if text not in warnings and not text.startswith("diameter"):
+        kinds = {text.split(":")[0] for text in warnings}
+        for text in result.warnings.row(0):  # one warning of each kind (the first impact's figures)
+            if text.split(":")[0] not in kinds and not text.startswith("diameter"):
                 warnings.append(text)
     rest = impacts[-1]["time"] + impacts[-1]["contact_duration"]
     volumes = [i["bruise_volume"] for i in impacts]
