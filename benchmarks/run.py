@@ -11,6 +11,7 @@ is measured against a tight reference (DOP853 at rtol 1e-12) on a sample.
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import platform
 import shutil
 import subprocess
@@ -317,6 +318,12 @@ def main(argv=None):
 
     # ------------------------------------------------------------------ end to end (issue 6, section 5)
     end_to_end(record, args.quick)
+
+    # ------------------------------------------------------------------ damage (issue 7)
+    sys.path.insert(0, str(Path(__file__).parent))
+    from damage import damage_benchmarks
+
+    damage_benchmarks(record, args.quick)
 
     # ------------------------------------------------------------------ CLI
     exe = shutil.which("fruitimpact")

@@ -168,40 +168,67 @@ def _unload_slope(F, p):
 
 @nb.njit(**_JIT)
 def speed_of_energy(mass, c, energy):
-    """v ≥ 0 with m v² r(c v) = energy (loading: v toward the surface) [m/s]."""
+    """v ≥ 0 with m v² r(c v) = energy (loading: v toward the surface) [m/s].
+
+    In y = c v: y − ln(1 + y) = q, q = c² energy / m.  A start from the inverse series
+    (y = s + s²/3 + s³/36 − s⁴/270, s = √(2q), for q < 1) or from the fixed point
+    y = q + ln(1 + y) (q ≥ 1), then Halley steps (cubic convergence: two or three)."""
     if energy <= 0.0:
         return 0.0
     if c == 0.0:
         return math.sqrt(2.0 * energy / mass)
     q = c * c * energy / mass
-    y = math.sqrt(2.0 * q) + q  # above the root of the convex y² r(y) = q: Newton converges monotonically
-    for _ in range(100):
+    if q < 1.0:
+        root = math.sqrt(2.0 * q)
+        y = root * (1.0 + root * (1.0 / 3.0 + root * (1.0 / 36.0 - root / 270.0)))
+    else:
+        y = q + math.log1p(q + math.log1p(q))
+        y = q + math.log1p(y)
+    for _ in range(30):
         f = y * y * r_func(y) - q
-        if f <= 0.0:  # monotone from above: at the root to rounding
-            break
-        step = f * (1.0 + y) / y
-        y -= step
-        if step <= 1e-15 * y:
+        d1 = y / (1.0 + y)
+        d2 = 1.0 / ((1.0 + y) * (1.0 + y))
+        step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
+        y_new = y - step
+        if not y_new > 0.0:
+            y_new = 0.5 * y
+        y = y_new
+        if abs(step) <= 4e-16 * y:
             break
     return y / c
 
 
 @nb.njit(**_JIT)
 def rebound_speed_of_energy(mass, c, energy):
-    """w ≥ 0 with m w² r(−c w) = energy (unloading: v = −w away from the surface) [m/s]."""
+    """w ≥ 0 with m w² r(−c w) = energy (unloading: v = −w away from the surface) [m/s].
+
+    In y = c w ∈ (0, 1): −y − ln(1 − y) = q.  A start from the inverse series
+    (y = s − s²/3 + s³/36 + s⁴/270, s = √(2q), for q < 1) or from y = 1 − exp(−1 − q) (q ≥ 1),
+    then Halley steps."""
     if energy <= 0.0:
         return 0.0
     if c == 0.0:
         return math.sqrt(2.0 * energy / mass)
     q = c * c * energy / mass
-    y = min(math.sqrt(2.0 * q), 1.0 - math.exp(-1.0 - q))  # above the root (convex, increasing)
-    for _ in range(200):
+    if q < 1.0:
+        root = math.sqrt(2.0 * q)
+        y = root * (1.0 + root * (-1.0 / 3.0 + root * (1.0 / 36.0 + root / 270.0)))
+    else:
+        y = -math.expm1(-1.0 - q)
+        y = -math.expm1(-q - y)
+    if not 0.0 < y < 1.0:
+        y = 0.5
+    for _ in range(60):
         f = y * y * r_func(-y) - q
-        if f <= 0.0:  # monotone from above: at the root to rounding
-            break
-        step = f * (1.0 - y) / y
-        y -= step
-        if step <= 1e-15 * y:
+        one_minus = 1.0 - y
+        d1 = y / one_minus
+        d2 = 1.0 / (one_minus * one_minus)
+        step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
+        y_new = y - step
+        if not 0.0 < y_new < 1.0:  # keep inside (0, 1): bisect towards the side the step points to
+            y_new = 0.5 * (y + (1.0 if y_new >= 1.0 else 0.0))
+        y = y_new
+        if abs(step) <= 4e-16 * y:
             break
     return y / c
 
@@ -268,7 +295,7 @@ def _root_on(a, b, mass, c, energy, p, pressure, yield_pressure):
         else:
             b, fb = m, fm
             fa *= 0.5
-        if b - a <= 1e-14 * b:
+        if b - a <= (1e-8 if pressure else 1e-12) * b:  # a peak's value is quadratic in its location error
             break
     return 0.5 * (a + b)
 
@@ -303,21 +330,28 @@ def _largest(mass, c, energy, p, F_star, pressure, yield_pressure):
 
 
 @nb.njit(**_JIT)
-def _piece(a, b, low_singular, high_singular, unloading, mass, c, energy, p, nodes, weights):
-    """∫_a^b (dδ/dF) / |v(F)| dF on one smooth piece with at most one singular end [s]."""
+def _piece(a, b, first_touch, F_star, unloading, mass, c, energy, p, nodes, weights):
+    """∫_a^b (dδ/dF) / |v(F)| dF on one smooth piece [s].
+
+    ``first_touch`` (a = 0): F = b u^6, smooth against the F^(−1/3) (Hertz) and F^(−1/2) (layer) slopes
+    at F = 0.  Otherwise F = F* − s²: 1/v grows like (F* − F)^(−1/2) towards the turn F*, and the
+    substitution makes the integrand smooth on every piece, however close to the turn it ends."""
     total = 0.0
-    width = b - a
+    if first_touch:
+        width = b - a
+    else:
+        s_high = math.sqrt(F_star - a)
+        s_low = math.sqrt(max(F_star - b, 0.0))
+        width = s_high - s_low
     for j in range(nodes.shape[0]):
         u = 0.5 * (nodes[j] + 1.0)  # on (0, 1)
-        if low_singular:  # F = a + (b − a) u^6: smooth against F^(−1/3) and F^(−1/2) at a = 0
+        if first_touch:
             F = a + width * u ** 6
             jac = 6.0 * width * u ** 5
-        elif high_singular:  # F = b − (b − a) u²: smooth against (F* − F)^(−1/2)
-            F = b - width * u * u
-            jac = 2.0 * width * u
         else:
-            F = a + width * u
-            jac = width
+            s_node = s_low + width * u
+            F = F_star - s_node * s_node
+            jac = 2.0 * s_node * width
         if unloading:
             v = rebound_speed_of_energy(mass, c, energy - unload_energy(F, p))
             slope = _unload_slope(F, p)
@@ -329,16 +363,16 @@ def _piece(a, b, low_singular, high_singular, unloading, mass, c, energy, p, nod
 
 
 @nb.njit(**_JIT)
-def _segment(a, b, low_singular, high_singular, unloading, mass, c, energy, p, nodes, weights):
-    """∫_a^b (dδ/dF) / |v(F)| dF on one smooth piece [s]; ``low_singular``: a = 0 (first touch or
-    separation, F^(−1/3) and F^(−1/2) slopes), ``high_singular``: b = F* (the turn, v ~ √(F* − F))."""
+def _segment(a, b, F_star, unloading, mass, c, energy, p, nodes, weights):
+    """∫_a^b (dδ/dF) / |v(F)| dF on one piece between kinks [s]; the piece from first touch is split
+    at half its end, the lower half taking the first-touch substitution."""
     if b <= a:
         return 0.0
-    if low_singular and high_singular:
-        mid = 0.5 * (a + b)
-        return _piece(a, mid, True, False, unloading, mass, c, energy, p, nodes, weights) + \
-            _piece(mid, b, False, True, unloading, mass, c, energy, p, nodes, weights)
-    return _piece(a, b, low_singular, high_singular, unloading, mass, c, energy, p, nodes, weights)
+    if a == 0.0:
+        mid = 0.5 * b
+        return _piece(0.0, mid, True, F_star, unloading, mass, c, energy, p, nodes, weights) + \
+            _piece(mid, b, False, F_star, unloading, mass, c, energy, p, nodes, weights)
+    return _piece(a, b, False, F_star, unloading, mass, c, energy, p, nodes, weights)
 
 
 @nb.njit(**_JIT)
@@ -358,8 +392,7 @@ def _branch_time(F_end, F_star, unloading, mass, c, energy, p, nodes, weights):
         cuts[1], cuts[2] = cuts[2], cuts[1]
     total = 0.0
     for k in range(n - 1):
-        total += _segment(cuts[k], cuts[k + 1], k == 0, cuts[k + 1] == F_star, unloading, mass, c, energy, p,
-                          nodes, weights)
+        total += _segment(cuts[k], cuts[k + 1], F_star, unloading, mass, c, energy, p, nodes, weights)
     return total
 
 
@@ -448,7 +481,7 @@ def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressu
     time_to_max = _branch_time(F_star, F_star, False, mass, c, energy, p, nodes, weights)
     time_to_peak = time_to_max
     if F_peak_T < F_star:  # the rest of loading, from the peak to the turn, is the smoother integral
-        time_to_peak -= _segment(F_peak_T, F_star, False, True, False, mass, c, energy, p, nodes, weights) \
+        time_to_peak -= _segment(F_peak_T, F_star, F_star, False, mass, c, energy, p, nodes, weights) \
             if not (F_peak_T < p[FY_] < F_star or F_peak_T < p[FB_] < F_star) else \
             time_to_max - _branch_time(F_peak_T, F_star, False, mass, c, energy, p, nodes, weights)
     unload_time = _branch_time(F_star, F_star, True, mass, c, returned, p, nodes, weights)
