@@ -30,6 +30,14 @@ from .status import STATUS_NAMES
 from .validation import InputError, check_choice, check_value, read_value
 
 
+def _unvalidated(cls, values: dict):
+    """An instance of the frozen dataclass ``cls`` whose values were validated by the table already."""
+    instance = object.__new__(cls)
+    for item in fields(cls):
+        object.__setattr__(instance, item.name, values.get(item.name))
+    return instance
+
+
 @dataclass(frozen=True)
 class Fruit:
     """A fruit, locally a sphere at the contact point.
@@ -67,10 +75,7 @@ class Fruit:
     @classmethod
     def _checked(cls, **values) -> "Fruit":
         """A Fruit of values that have just passed the same checks (no second validation)."""
-        fruit = object.__new__(cls)
-        for item in fields(cls):
-            object.__setattr__(fruit, item.name, values.get(item.name))
-        return fruit
+        return _unvalidated(cls, values)
 
     @property
     def radius(self) -> float:
@@ -108,10 +113,7 @@ class Surface:
     @classmethod
     def _checked(cls, **values) -> "Surface":
         """A Surface of values that have just passed the same checks (no second validation)."""
-        surface = object.__new__(cls)
-        for item in fields(cls):
-            object.__setattr__(surface, item.name, values.get(item.name))
-        return surface
+        return _unvalidated(cls, values)
 
 
 RIGID_PLANE = Surface()

@@ -181,6 +181,8 @@ def speed_of_energy(mass, c, energy):
     if q < 1.0:
         root = math.sqrt(2.0 * q)
         y = root * (1.0 + root * (1.0 / 3.0 + root * (1.0 / 36.0 - root / 270.0)))
+        if q < 1e-8:  # the series' next term is ~s⁵/4320: below rounding here, and Halley would cancel
+            return y / c
     else:
         y = q + math.log1p(q + math.log1p(q))
         y = q + math.log1p(y)
@@ -213,6 +215,8 @@ def rebound_speed_of_energy(mass, c, energy):
     if q < 1.0:
         root = math.sqrt(2.0 * q)
         y = root * (1.0 + root * (-1.0 / 3.0 + root * (1.0 / 36.0 + root / 270.0)))
+        if q < 1e-8:
+            return y / c
     else:
         y = -math.expm1(-1.0 - q)
         y = -math.expm1(-q - y)
@@ -333,44 +337,53 @@ def _largest(mass, c, energy, p, F_star, pressure, yield_pressure):
 def _piece(a, b, first_touch, F_star, unloading, mass, c, energy, p, nodes, weights):
     """∫_a^b (dδ/dF) / |v(F)| dF on one smooth piece [s].
 
-    ``first_touch`` (a = 0): F = b u^6, smooth against the F^(−1/3) (Hertz) and F^(−1/2) (layer) slopes
-    at F = 0.  Otherwise F = F* − s²: 1/v grows like (F* − F)^(−1/2) towards the turn F*, and the
+    ``first_touch``: F = w^6 (w from a^(1/6) to b^(1/6)), smooth against the F^(−1/3) (Hertz) and
+    F^(−1/2) (layer) slopes of F = 0, on [0, b] or just above it.  Otherwise F = F* − s²: 1/v grows like (F* − F)^(−1/2) towards the turn F*, and the
     substitution makes the integrand smooth on every piece, however close to the turn it ends."""
     total = 0.0
     if first_touch:
-        width = b - a
+        u_low = a ** (1.0 / 6.0)
+        width = b ** (1.0 / 6.0) - u_low
     else:
         s_high = math.sqrt(F_star - a)
         s_low = math.sqrt(max(F_star - b, 0.0))
         width = s_high - s_low
     for j in range(nodes.shape[0]):
         u = 0.5 * (nodes[j] + 1.0)  # on (0, 1)
-        if first_touch:
-            F = a + width * u ** 6
-            jac = 6.0 * width * u ** 5
+        if first_touch:  # F = w^6, w from a^(1/6) to b^(1/6): smooth against F^(−1/3), F^(−1/2) at F = 0
+            w = u_low + width * u
+            F = w ** 6
+            jac = 6.0 * width * w ** 5
+            gap = F_star - F
         else:
             s_node = s_low + width * u
-            F = F_star - s_node * s_node
+            gap = s_node * s_node  # F* − F, exact even where F rounds to F*
+            F = F_star - gap
             jac = 2.0 * s_node * width
+        # the energy left at F, W(F*) − W(F): where the difference of the closed forms cancels to rounding
+        # (right at the turn, just above a kink), its first-order value F δ'(F) (F* − F) instead
         if unloading:
-            v = rebound_speed_of_energy(mass, c, energy - unload_energy(F, p))
             slope = _unload_slope(F, p)
+            left = energy - unload_energy(F, p)
         else:
-            v = speed_of_energy(mass, c, energy - load_work(F, p))
             slope = _load_slope(F, p)
+            left = energy - load_work(F, p)
+        if left < 1e-13 * energy:
+            left = F * slope * gap
+        v = rebound_speed_of_energy(mass, c, left) if unloading else speed_of_energy(mass, c, left)
         total += 0.5 * weights[j] * jac * slope / v
     return total
 
 
 @nb.njit(**_JIT)
 def _segment(a, b, F_star, unloading, mass, c, energy, p, nodes, weights):
-    """∫_a^b (dδ/dF) / |v(F)| dF on one piece between kinks [s]; the piece from first touch is split
-    at half its end, the lower half taking the first-touch substitution."""
+    """∫_a^b (dδ/dF) / |v(F)| dF on one piece between kinks [s]; a piece from first touch, or from a
+    kink well below its end, is split at its middle, the lower half taking the F = w^6 substitution."""
     if b <= a:
         return 0.0
-    if a == 0.0:
-        mid = 0.5 * b
-        return _piece(0.0, mid, True, F_star, unloading, mass, c, energy, p, nodes, weights) + \
+    if a < 0.5 * b:  # first touch (a = 0), or a kink well below b: the slopes' F = 0 singularity is near
+        mid = 0.5 * (a + b)
+        return _piece(a, mid, True, F_star, unloading, mass, c, energy, p, nodes, weights) + \
             _piece(mid, b, False, F_star, unloading, mass, c, energy, p, nodes, weights)
     return _piece(a, b, False, F_star, unloading, mass, c, energy, p, nodes, weights)
 
