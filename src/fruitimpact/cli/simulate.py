@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ..quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS
+from ..quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS, OUTPUTS
 from .common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
 
 
@@ -37,6 +37,23 @@ def format_result_table(result) -> str:
     for quantity in (CHARACTERISTICS[name] for name in CHARACTERISTIC_NAMES):
         value = getattr(c, quantity.name) * quantity.scale
         lines.append(f"{quantity.label:<28}{value:>14.6g}  {quantity.unit}")
+    damage = result.damage
+    names = result.names
+    if names.get("surface", "rigid") != "rigid" or names.get("fruit", "jonathan-apple") != "jonathan-apple":
+        lines.insert(1, f"library    fruit {names.get('fruit')}, surface {names.get('surface')}")
+    shown = [name for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work",
+                               "fruit_energy", "max_shear_stress", "bruise_volume", "bruise_depth", "bruise_width")
+             if result.plastic or names.get("criterion", "none") != "none"]
+    if shown:
+        lines += ["", f"damage (criterion {names.get('criterion', 'none')}"
+                      + (f": {'bruised' if damage['bruised'] else 'not bruised'}, margin "
+                         f"{damage['bruise_margin']:+.3g}" if damage.get("bruised") is not None else "") + ")"]
+        for name in shown:
+            quantity = OUTPUTS[name]
+            value = damage[name]
+            if math.isnan(value):
+                continue
+            lines.append(f"{quantity.label:<28}{value * quantity.scale:>14.6g}  {quantity.unit}")
     if not math.isnan(c.max_deflection_closed_form):
         lines += ["", "closed-form self-check (first integral of the force law):",
                   f"  δ_max = {c.max_deflection_closed_form * 1e3:.9g} mm "
