@@ -202,3 +202,55 @@ def test_runs_accept_the_damage_inputs(cli, tmp_path):
 def test_bad_damage_inputs_are_one_line_errors(cli, argv, option):
     line = cli.error(*argv)
     assert option in line, line
+
+
+# ------------------------------------------------------------------ defects found by attacking the CLI
+def test_a_bad_energy_threshold_is_one_invalid_row_not_a_dead_batch(cli, tmp_path):
+    """Before: --bruise-energy 0 with the energy criterion raised from the bruise module (a traceback in sweep,
+    a fatal error in batch that left a work folder blocking the retry)."""
+    table = tmp_path / "in.csv"
+    table.write_text("drop_height,criterion,bruise_energy\n10cm,energy,0\n10cm,energy,0.05\n")
+    out = tmp_path / "out.csv"
+    cli.ok("batch", table, "-o", out)
+    import csv
+
+    with open(out) as handle:
+        rows = list(csv.DictReader(handle))
+    assert rows[0]["status"] == "invalid" and "bruise_energy must be > 0" in rows[0]["message"]
+    assert rows[1]["status"] == "ok"
+    assert "--bruise-energy" in cli.error("sweep", "--drop-height", "1cm:1m:3", "--criterion", "energy",
+                                          "--bruise-energy", "0", "-o", tmp_path / "s.csv")
+    assert "--bruise-energy" in cli.error("population", "-n", "100", "--criterion", "energy", "--drop-height", "10cm")
+
+
+def test_the_fruit_threshold_belongs_to_the_energy_criterion():
+    """Before: the apple's 0.08 J threshold was subtracted under the pressure criterion: bruised, volume 0."""
+    frame = batch.evaluate({"fruit": ["apple", "apple"], "criterion": ["pressure", "energy"], "drop_height": [0.3, 0.3]})
+    assert list(frame["bruise_energy"]) == [0.0, 0.08]
+    assert frame.loc[0, "bruised"] == 1.0 and frame.loc[0, "bruise_volume"] > 0.0
+
+
+def test_failed_rows_carry_no_damage_figures():
+    frame = batch.evaluate({"yield_pressure": [1e-300], "criterion": ["pressure"]})
+    assert frame.loc[0, "status"] == "failed"
+    assert np.isnan(frame.loc[0, "bruised"]) and np.isnan(frame.loc[0, "plastic_work"])
+
+
+def test_line_counts_invalid_fruit_and_uses_one_population(tmp_path, cli):
+    line = tmp_path / "line.csv"
+    line.write_bytes("\ufeffname,drop_height,surface\nA,20cm,steel\nB,5cm,pvc-belt\n".encode("utf-8"))  # a BOM
+    status, out, err = cli.run("line", line, "--criterion", "pressure", "-n", "500", "--mass", "normal(180g,200g)",
+                               "--json")
+    assert status == 0
+    import json
+
+    report = json.loads(out)
+    assert report["warnings"] and "not computed" in err
+    first = report["points"][0]
+    assert first["cumulative_incidence"] == pytest.approx(first["incidence"], abs=1e-12)
+
+
+def test_a_safe_height_that_cannot_be_found_is_not_a_result(cli):
+    status, out, err = cli.run("safe-height", "--criterion", "pressure", "--yield-pressure", "1e-300",
+                               "--no-sensitivity")
+    assert status == 1 and "nan" not in out

@@ -350,17 +350,19 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
 
     leaves_hertz = (status != INVALID) & (out[:, CONTACT_RADIUS] > HERTZ_RANGE * radius)
     if leaves_hertz.any():
-        ratio = f" = {float(out[0, CONTACT_RADIUS] / radius[0]):.2g}" if detail else ""
+        ratio = f" = {float(out[0, CONTACT_RADIUS] / radius[0]):.3g}" if detail else ""
         warnings.add(leaves_hertz, f"the contact radius leaves Hertz's range: a/R{ratio} > {HERTZ_RANGE:g} "
                                    f"(δ_max/R > {HERTZ_RANGE ** 2:g}), where the paraboloid that Hertz puts in "
                                    f"place of the fruit is more than 4 % off; treat the figures as an estimate")
 
     done = status != INVALID
     _range_warnings(warnings, out, plastic_block, layer, thickness, used["surface_thickness"], radius, done, detail)
-    damage = _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, fruit_modulus, pair_modulus,
-                             layer, resolved)
+    # failed rows carry no damage figures (their characteristics are not an impact)
+    damage = _damage_columns(out, plastic_block, done & (status != FAILED), mass, velocity, used, inputs,
+                             fruit_modulus, pair_modulus, layer, resolved)
     columns = {name: used[name] for name in NUMERIC_INPUTS if name in INPUT_OUTPUTS}
     columns["yield_pressure"] = yield_pressure
+    columns["bruise_energy"] = damage.pop("bruise_energy")
     columns.update(damage)
     columns["drop_height"] = np.where(given["drop_height"], values["drop_height"], np.nan)
     columns["alpha"] = np.where(given["alpha"], values["alpha"], np.nan)
@@ -416,10 +418,12 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
             messages.set(where & resolved.no_threshold & ~given["bruise_energy"] & ~messages.flagged,
                          "bruise_energy must be given for the energy criterion (the absorbed energy at bruise onset "
                          "[J]; the --fruit's library entry has none)", "bruise_energy")
+            messages.set(where & given["bruise_energy"] & ~(inputs.values["bruise_energy"] > 0.0) & ~messages.flagged,
+                         "bruise_energy must be > 0 J for the energy criterion (its threshold)", "bruise_energy")
         elif name == "shear":
             poisson = used["poisson"]
             messages.set(where & ~((poisson >= 0.0) & (poisson <= 0.5)) & ~messages.flagged,
-                         "poisson must be in [0, 0.5] for the shear criterion (Hertz's subsurface field)", "poisson")
+                         "poisson must be in [0, 0.5) for the shear criterion (Hertz's subsurface field)", "poisson")
 
 
 def _range_warnings(warnings: WarningBook, out, plastic_block, layer, thickness, given_thickness, radius, done,
@@ -461,18 +465,23 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
         for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
             columns[name] = np.where(computed, plastic_block[:, PLASTIC_COLUMNS.index(name)], columns[name])
         share = np.where(computed & layer, plastic_block[:, PLASTIC_COLUMNS.index("fruit_work_share")], share)
+    ok = done & np.isfinite(absorbed)
     for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
-        columns[name] = np.where(done, columns[name], np.nan)
-    columns["fruit_energy"] = np.where(done, absorbed * share, np.nan)
+        columns[name] = np.where(ok, columns[name], np.nan)
+    columns["fruit_energy"] = np.where(ok, absorbed * share, np.nan)
     criterion = inputs.text["criterion"]
     codes = np.asarray([CRITERION_NAMES.index(label) if label in CRITERION_NAMES else 0
                         for label in criterion.labels], dtype=np.int8)[criterion.codes] \
         if len(criterion.labels) else np.zeros(rows, dtype=np.int8)
+    # the fruit's library threshold is the energy criterion's; the stress criteria subtract only a given one
+    threshold = np.where((codes == CRITERION_NAMES.index("energy")) | inputs.given["bruise_energy"],
+                         used["bruise_energy"], 0.0)
+    columns["bruise_energy"] = threshold
     columns.update(bruise_columns(codes, peak_pressure=out[:, COLUMN["max_pressure"]], poisson=used["poisson"],
                                   fruit_energy=columns["fruit_energy"], failure_stress=used["failure_stress"],
-                                  threshold_energy=used["bruise_energy"], susceptibility=used["bruise_susceptibility"],
+                                  threshold_energy=threshold, susceptibility=used["bruise_susceptibility"],
                                   contact_radius=out[:, CONTACT_RADIUS], valid=done))
-    return {name: columns[name] for name in DAMAGE_NAMES}
+    return {name: columns[name] for name in (*DAMAGE_NAMES, "bruise_energy")}
 
 
 def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):

@@ -145,11 +145,12 @@ def cmd_safe_height(args) -> int:
 
             _library_call(save_figure, risk_map_figure(key, columns, heights, rows, safe, report["criterion"]),
                           args.plot, "--plot")
+    height = report["safe_height"]
+    report["status"] = "ok" if not math.isnan(height) else "failed"
     if args.json:
         print(dump_json(report))
     else:
-        height = report["safe_height"]
-        shown = "inf" if math.isinf(height) else f"{height * 100:.4g} cm"
+        shown = "inf" if math.isinf(height) else "not found" if math.isnan(height) else f"{height * 100:.4g} cm"
         print(f"safe drop height {shown} (criterion {report['criterion']}): {report['message']}")
         for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy"):
             if name in report:
@@ -164,7 +165,7 @@ def cmd_safe_height(args) -> int:
         for what, path in (("risk map", args.map_csv), ("figure", args.plot)):
             if path:
                 print(f"{what} written to {path}")
-    return 0
+    return 0 if report["status"] == "ok" else 1
 
 
 # ------------------------------------------------------------------------------------------------ line
@@ -203,6 +204,7 @@ def cmd_line(args) -> int:
     members, _ = source.inputs(0, rows, None)
     members.pop("model", None)
     report = _library_call(audit, points, members, rows, criterion, constants)
+    _print_warnings("line", report["warnings"])
     report["seed"] = seed
     report["inputs"] = {name: dist.describe() for name, dist in distributions}
     if args.plot:
@@ -257,7 +259,10 @@ def cmd_fruits(args) -> int:
 def cmd_surfaces(args) -> int:
     from ..library import surface_rows
 
-    return _library_listing(args, surface_rows(), "surfaces")
+    status = _library_listing(args, surface_rows(), "surfaces")
+    if not args.json:
+        print("rigid: the default --surface: no library values, the --surface-* options as given (a rigid flat)")
+    return status
 
 
 def add_parsers(sub) -> None:

@@ -153,16 +153,20 @@ def _status_line(summary) -> str:
     return line
 
 
-def _check_constants(constants: dict, text: dict) -> None:
-    """Refuse a constant input out of its range before any chunk runs (one row through batch.evaluate)."""
+def _check_constants(constants: dict, text: dict, given=()) -> None:
+    """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
+    energy criterion's threshold), before any chunk runs (one row through batch.evaluate)."""
     from ..batch import evaluate
+    from ..quantities import INPUTS
 
     if not constants and not text:
         return
     probe = evaluate({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
     message = str(probe["message"].iloc[0])
-    if str(probe["status"].iloc[0]) == "invalid" and message.split(" ", 1)[0] in set(constants) | set(text) \
-            and message.split(" ", 1)[0] not in _DEPENDENT_INPUTS:
+    first = message.split(" ", 1)[0]
+    if str(probe["status"].iloc[0]) != "invalid" or first in _DEPENDENT_INPUTS:
+        return
+    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given) and "must be given" in message):
         raise UsageError(_with_option(message))
 
 
@@ -215,7 +219,7 @@ def cmd_sweep(args) -> int:
             axis = runs.parse_axis(dest, getattr(args, dest))
         except ValueError as exc:
             raise UsageError(f"argument {option}: {exc}") from None
-        if dest in ("model", "calibration", "method"):
+        if not axis.numeric:
             _check_text(dest, axis.values)
         if len(axis.values) > 1:
             axes.append(axis)
@@ -224,7 +228,7 @@ def cmd_sweep(args) -> int:
         else:
             text[dest] = axis.values[0]
     _check_conflicts(order)
-    _check_constants(constants, text)
+    _check_constants(constants, text, order)
     try:
         name = runs.characteristic(args.characteristic).name
     except ValueError as exc:
@@ -306,7 +310,7 @@ def cmd_population(args) -> int:
         if isinstance(dist, Constant):
             constants[dest] = dist.value
     _check_conflicts([d for d, _ in distributions])
-    _check_constants(constants, text)
+    _check_constants(constants, text, [d for d, _ in distributions] + list(text))
     try:
         names = runs.characteristics_list(args.characteristics) if args.characteristics else runs.DEFAULT_SUMMARY
     except ValueError as exc:

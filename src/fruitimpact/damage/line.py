@@ -48,7 +48,7 @@ def read_line(path) -> list[TransferPoint]:
     from ..units import parse_quantity
 
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
+        with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
             lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
     except OSError as exc:
         raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
@@ -102,15 +102,18 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``points`` (one dict per transfer point: ``name``, ``drop_height``, ``surface``,
     ``fruit_on_fruit``, ``velocity``, ``incidence``, ``mean_bruise_volume``, ``mean_peak_force``,
     ``mean_max_pressure``, ``cumulative_incidence``, ``cumulative_bruise_volume``, ``invalid``,
-    ``failed``), ``worst_point``, ``incidence`` (on the whole line), ``mean_bruise_volume``
-    and ``criterion``."""
+    ``failed``), ``worst_point``, ``incidence`` (on the whole line), ``mean_bruise_volume``,
+    ``criterion`` and ``warnings``.  A point's figures are over the fruit computed there; the
+    cumulated ones over the fruit computed at every point so far (a warning counts the others)."""
     from ..batch import evaluation
     from ..constants import STANDARD_GRAVITY
     from ..validation import InputError
 
     bruised_any = np.zeros(rows, dtype=bool)
     volume_total = np.zeros(rows)
+    valid_so_far = np.ones(rows, dtype=bool)  # fruit computed at every point so far: the cumulation's population
     report = []
+    warnings = []
     for point in points:
         table = {**members, **constants, "drop_height": np.full(rows, point.drop_height),
                  "surface": "fruit" if point.fruit_on_fruit else point.surface, "criterion": criterion}
@@ -124,7 +127,14 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
         bruised_any |= bruised
         volume_total += volume
+        valid_so_far &= ok
         count = max(int(ok.sum()), 1)
+        if not ok.all():
+            first = int(np.flatnonzero(~ok)[0])
+            warnings.append(f"transfer point {point.name!r}: {int((~ok).sum())} of {rows} fruit not computed "
+                            f"(invalid or failed; the first: {result.messages.text(first)}); the figures are of the "
+                            f"others")
+        kept = max(int(valid_so_far.sum()), 1)
         report.append({
             "name": point.name, "drop_height": point.drop_height, "surface": point.surface,
             "fruit_on_fruit": point.fruit_on_fruit,
@@ -133,13 +143,15 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             "mean_bruise_volume": float(volume[ok].sum() / count),
             "mean_peak_force": float(np.mean(result.columns["peak_force"][ok])) if ok.any() else math.nan,
             "mean_max_pressure": float(np.mean(result.columns["max_pressure"][ok])) if ok.any() else math.nan,
-            "cumulative_incidence": float(bruised_any.mean()),
-            "cumulative_bruise_volume": float(volume_total.mean()),
+            "cumulative_incidence": float(bruised_any[valid_so_far].sum() / kept),
+            "cumulative_bruise_volume": float(volume_total[valid_so_far].sum() / kept),
             "invalid": int((status == 3).sum()), "failed": int((status == 2).sum()),
         })
     worst = max(range(len(report)), key=lambda i: (report[i]["incidence"], report[i]["mean_bruise_volume"]))
-    return {"criterion": criterion, "fruit": rows, "points": report, "worst_point": report[worst]["name"],
-            "incidence": float(bruised_any.mean()), "mean_bruise_volume": float(volume_total.mean())}
+    kept = max(int(valid_so_far.sum()), 1)
+    return {"criterion": criterion, "fruit": rows, "fruit_computed": int(valid_so_far.sum()), "points": report,
+            "worst_point": report[worst]["name"], "incidence": float(bruised_any[valid_so_far].sum() / kept),
+            "mean_bruise_volume": float(volume_total[valid_so_far].sum() / kept), "warnings": warnings}
 
 
 __all__ = ["LINE_COLUMNS", "MAX_POINTS", "TransferPoint", "audit", "read_line"]
