@@ -15,12 +15,12 @@ import sys
 
 PROG = "fruitimpact"
 COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population", "drop", "safe-height", "line", "fruits",
-            "surfaces")
+            "surfaces", "analyze", "classes", "stream", "synth")
 
 
 def build_parser():
     """The argparse parser of every command (built from the table of quantities)."""
-    from . import damage, reference, runs, simulate
+    from . import damage, reference, runs, signals, simulate
     from .common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
@@ -29,6 +29,7 @@ def build_parser():
     reference.add_parsers(sub)
     runs.add_parsers(sub)
     damage.add_parsers(sub)
+    signals.add_parsers(sub)
     return parser
 
 

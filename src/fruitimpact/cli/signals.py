@@ -1,0 +1,453 @@
+"""Measured impacts: ``analyze`` (a recording), ``stream`` (samples arriving), ``synth`` (a synthetic
+sensor with its truth) and ``classes`` (firmness thresholds calibrated on labelled fruit)."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+from .common import PROG, UsageError, _library_call, dump_json
+from ..units import parse_quantity
+
+
+def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
+    if text is None:
+        return None
+    try:
+        value = parse_quantity(text, dimension)
+    except ValueError as exc:
+        raise UsageError(f"argument {option}: {exc}") from None
+    ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
+    if not ok:
+        bracket = "[" if low_inclusive else "("
+        raise UsageError(f"argument {option}: must be a number in {bracket}{low:g}, {high:g}]; got {text!r}")
+    return value
+
+
+def _json_line(obj) -> str:
+    return json.dumps(json.loads(dump_json(obj)), separators=(",", ":"), ensure_ascii=False)
+
+
+def add_analysis_options(parser) -> None:
+    """Options shared by ``analyze`` and ``stream`` (the same analysis of every impact)."""
+    det = parser.add_argument_group("detection (defaults suit fruit on a force plate at 10-50 kHz)")
+    det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic")
+    det.add_argument("--lowpass", metavar="HZ", help="causal Butterworth low-pass (order 4) at this frequency")
+    det.add_argument("--rebound-window", metavar="S",
+                     help="an impact within this time after the previous one, and smaller, is its rebound (default: "
+                          "the longest flight 2 V/g + 10 ms when the velocity or drop height is given, else 0.1 s)")
+    det.add_argument("--k-on", default="6", metavar="K", help="onset threshold in noise σ (default 6)")
+    det.add_argument("--k-off", default="3", metavar="K", help="offset threshold in noise σ (default 3)")
+    det.add_argument("--clip", metavar="LOW,HIGH", help="the acquisition's limits [N]: impacts reaching them are flagged")
+    fit = parser.add_argument_group("fit of the simulator's force law (--fit)")
+    fit.add_argument("--fit", action="store_true", help="fit the Hunt–Crossley pulse to every impact")
+    fit.add_argument("--drop-height", metavar="H", help="the line's drop height: V = √(2 g h) (the fit gives the mass)")
+    fit.add_argument("--velocity", metavar="V", help="impact velocity (the fit gives the mass)")
+    fit.add_argument("--mass", metavar="M", help="fruit mass (the fit gives the velocity)")
+    fit.add_argument("--diameter", metavar="D", help="fruit diameter, with --poisson: the fit gives E")
+    fit.add_argument("--poisson", metavar="NU", help="Poisson's ratio, with --diameter")
+    sort = parser.add_argument_group("firmness classes")
+    sort.add_argument("--sort-by", metavar="INDEX", help="firmness_c, firmness_c_star, modulus, stiffness or peak_force")
+    sort.add_argument("--thresholds", metavar="A,B,...", help="ascending thresholds of --sort-by [SI]")
+    sort.add_argument("--classes", metavar="NAMES", help="class names, softest first (default soft,medium,firm,...)")
+
+
+def analysis_from(args, rate: float):
+    """(DetectorSettings, Analysis) from the options, every value checked before any work."""
+    from ..constants import STANDARD_GRAVITY
+    from ..signals.analysis import Analysis
+    from ..signals.detect import DetectorSettings
+    from ..signals.sort import FirmnessClasses
+
+    hum = _float("--hum", args.hum, "frequency")
+    lowpass = _float("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
+    clip = (None, None)
+    if args.clip:
+        try:
+            low, high = (float(parse_quantity(v, "force")) for v in args.clip.split(","))
+        except ValueError:
+            raise UsageError(f"argument --clip: expected LOW,HIGH in N; got {args.clip!r}") from None
+        if not low < high:
+            raise UsageError(f"argument --clip: LOW must be below HIGH; got {args.clip!r}")
+        clip = (low, high)
+    velocity = _float("--velocity", args.velocity, "velocity")
+    height = _float("--drop-height", args.drop_height, "length", high=10.0)
+    if velocity is not None and height is not None:
+        raise UsageError("give either --velocity or --drop-height, not both")
+    if height is not None:
+        velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
+    window = _float("--rebound-window", args.rebound_window, "time", low_inclusive=True, high=10.0)
+    if window is None:  # a rebound flies at most 2 V/g (e <= 1)
+        window = 2.0 * velocity / STANDARD_GRAVITY + 0.01 if velocity is not None else 0.1
+    try:
+        settings = DetectorSettings(
+            rebound_window=window,
+            k_on=_float("--k-on", args.k_on, "dimensionless"), k_off=_float("--k-off", args.k_off, "dimensionless"),
+            hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
+            clip_low=clip[0], clip_high=clip[1])
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    mass = _float("--mass", args.mass, "mass")
+    diameter = _float("--diameter", args.diameter, "length")
+    poisson = _float("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
+    classes = None
+    if args.sort_by or args.thresholds:
+        if not (args.sort_by and args.thresholds):
+            raise UsageError("argument --thresholds: give --sort-by INDEX and --thresholds A,B,... together")
+        try:
+            thresholds = tuple(float(v) for v in args.thresholds.split(","))
+        except ValueError:
+            raise UsageError(f"argument --thresholds: expected numbers A,B,...; got {args.thresholds!r}") from None
+        names = tuple(args.classes.split(",")) if args.classes else \
+            (("soft", "medium", "firm", "very-firm", "hard", "very-hard")[:len(thresholds) + 1]
+             if len(thresholds) < 6 else tuple(f"class{k}" for k in range(len(thresholds) + 1)))
+        try:
+            classes = FirmnessClasses(args.sort_by, thresholds, names)
+        except ValueError as exc:
+            raise UsageError(f"argument --sort-by/--thresholds: {exc}") from None
+    try:
+        analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity if args.fit or velocity else None,
+                            mass=mass, diameter=diameter, poisson=poisson, classes=classes)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return settings, analysis
+
+
+# ------------------------------------------------------------------------------------------- analyze
+def cmd_analyze(args) -> int:
+    import numpy as np
+
+    from ..signals.analysis import public
+    from ..signals.detect import Detector
+    from ..signals.read import read_recording
+
+    rate = _float("--rate", args.rate, "frequency")
+    lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
+    if lanes is None:
+        raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
+    if args.plot:
+        from ..outputs import FIGURE_FORMATS, check_output
+
+        try:
+            check_output(args.plot, "--plot", FIGURE_FORMATS)
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
+    recording = _library_call(read_recording, args.file, rate=rate, column=args.column, format=args.format,
+                              lanes=lanes)
+    settings, analysis = analysis_from(args, recording.rate)
+    detector = _library_call(Detector, recording.rate, settings, lanes=len(recording.lanes))
+    matrix = np.column_stack([recording.lanes[name] for name in recording.lane_names])
+    impacts = detector.feed(matrix) + detector.flush()
+    impacts.sort(key=lambda impact: (impact.start_index, impact.lane))
+    reports = []
+    for impact in impacts:
+        report = analysis.report(impact)
+        report["lane"] = recording.lane_names[impact.lane]
+        report["start_time"] = report["start_time"] + recording.start_time
+        reports.append(report)
+        if args.json:
+            print(_json_line(public(report)), flush=False)
+    if not args.json:
+        print(f"{args.file}: {len(reports)} impacts in {recording.duration:.4g} s, {len(recording.lanes)} lane(s) at "
+              f"{recording.rate:g} Hz" + (" (fitted)" if analysis.fit else ""))
+        header = f"{'lane':<10}{'t [s]':>10}{'F_max [N]':>11}{'t_c [ms]':>10}{'T [ms]':>9}{'C [N/ms]':>10}" \
+                 f"{'C* [N/ms²]':>12}{'impulse':>10}  flags"
+        if analysis.fit:
+            header += "   k_c, e, m|V"
+        print(header)
+        for r in reports:
+            flags = ",".join(name for name in ("rebound", "clipped", "truncated") if r.get(name))
+            line = (f"{r['lane']:<10}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"
+                    f"{r['contact_duration'] * 1e3:>9.4g}{r['firmness_c'] / 1e3:>10.4g}"
+                    f"{r['firmness_c_star'] / 1e6:>12.4g}{r['impulse']:>10.4g}  {flags}")
+            if analysis.fit:
+                other = "mass" if analysis.velocity is not None else "velocity"
+                line += f"   {r.get('stiffness', math.nan):.4g}, {r.get('restitution', math.nan):.3g}, " \
+                        f"{r.get(other, math.nan):.4g}"
+            if "class" in r:
+                line += f"   {r['class']}"
+            print(line)
+    if args.plot:
+        from ..plotting import save_figure
+        from ..plotting.signals import analysis_figure
+
+        _library_call(save_figure, analysis_figure(recording, impacts, reports, analysis), args.plot, "--plot")
+        if not args.json:
+            print(f"figure written to {args.plot}")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------- classes
+def cmd_classes(args) -> int:
+    import csv
+
+    from ..signals.sort import SORT_INDICES, calibrate, confusion
+
+    if args.by not in SORT_INDICES:
+        raise UsageError(f"argument --by: must be one of {', '.join(SORT_INDICES)}; got {args.by!r}")
+    names = tuple(args.classes.split(","))
+    try:
+        with open(args.file, newline="", encoding="utf-8-sig") as handle:
+            if args.file.endswith(".jsonl") or args.file.endswith(".json"):
+                rows = [json.loads(line) for line in handle if line.strip()]
+            else:
+                rows = list(csv.DictReader(line for line in handle if not line.lstrip().startswith("#")))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise UsageError(f"argument FILE: cannot read {args.file}: {exc}") from None
+    if not rows:
+        raise UsageError(f"argument FILE: {args.file} has no rows")
+    for column in (args.by, args.label):
+        if column not in rows[0]:
+            raise UsageError(f"argument FILE: {args.file} has no column {column!r} (columns: {', '.join(rows[0])})")
+    try:
+        values = [float(row[args.by]) for row in rows]
+    except (TypeError, ValueError):
+        raise UsageError(f"argument FILE: column {args.by!r} must hold numbers") from None
+    labels = [row[args.label] for row in rows]
+    classes = _library_call(calibrate, values, labels, names, args.by)
+    report = {**classes.to_dict(), **confusion(labels, classes.classify(values), names), "reference_fruit": len(rows)}
+    if args.json:
+        print(dump_json(report))
+    else:
+        print(f"thresholds of {args.by}: " + ", ".join(f"{t:.6g}" for t in classes.thresholds)
+              + f"  ({len(rows)} reference fruit)")
+        corner = "true / sorted"
+        print(f"{corner:<14}" + "".join(f"{n:>10}" for n in names) + f"{'accuracy':>10}")
+        for name, row in zip(names, report["matrix"]):
+            print(f"{name:<14}" + "".join(f"{v:>10d}" for v in row)
+                  + f"{report['accuracy_per_class'][name] * 100:>9.3g}%")
+        print(f"accuracy {report['accuracy'] * 100:.3g} %, balanced {report['balanced_accuracy'] * 100:.3g} %")
+        print(f"use: --sort-by {args.by} --thresholds {','.join(f'{t:.6g}' for t in classes.thresholds)} "
+              f"--classes {','.join(names)}")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    an = sub.add_parser("analyze", help="find impacts in a force recording: indices, fitted physics, classes",
+                        description="Find the impacts in a force recording (CSV, NPY, raw float32, TDMS) and "
+                                    "report their indices, one JSON object per line with --json.")
+    an.add_argument("file", metavar="FILE", help="the recording")
+    an.add_argument("--rate", metavar="HZ", help="sample rate (needed for NPY, raw and CSV without a time column)")
+    an.add_argument("--column", metavar="NAME", help="analyse only this lane (a column or TDMS channel)")
+    an.add_argument("--format", metavar="FMT", help="csv, npy, f32 or tdms (default: from the extension)")
+    an.add_argument("--lanes", default="1", metavar="K", help="interleaved lanes of a raw float32 file (default 1)")
+    add_analysis_options(an)
+    an.add_argument("--json", action="store_true", help="one JSON object per line, one per impact (SI)")
+    an.add_argument("--plot", metavar="FILE", help="the recording with its impacts (and fits) (PNG/SVG/PDF)")
+    an.set_defaults(func=cmd_analyze)
+
+    cl = sub.add_parser("classes", help="calibrate firmness thresholds on labelled fruit (confusion matrix)",
+                        description="Calibrate the thresholds that best separate firmness classes on a labelled "
+                                    "reference set (CSV or JSON lines with the index and a label column).")
+    cl.add_argument("file", metavar="FILE", help="labelled reference fruit (CSV, or JSON lines from analyze)")
+    cl.add_argument("--by", default="firmness_c_star", metavar="INDEX", help="the index (default firmness_c_star)")
+    cl.add_argument("--label", default="label", metavar="COLUMN", help="the column of the known class (default label)")
+    cl.add_argument("--classes", default="soft,medium,firm", metavar="NAMES", help="class names, softest first")
+    cl.add_argument("--json", action="store_true", help="print JSON")
+    cl.set_defaults(func=cmd_classes)
+    add_synth_parser(sub)
+    add_stream_parser(sub)
+
+
+# --------------------------------------------------------------------------------------------- synth
+def _classes_option(text: str):
+    """``soft:2.5MPa,medium:4MPa,firm`` → ((label, upper bound of E [Pa]), …, (last, inf))."""
+    pairs = []
+    for item in text.split(","):
+        label, _, bound = item.partition(":")
+        if not label:
+            raise UsageError(f"argument --classes: expected LABEL:E_MAX,...,LABEL; got {text!r}")
+        pairs.append((label, _float("--classes", bound, "modulus") if bound else math.inf))
+    if pairs[-1][1] != math.inf:
+        pairs.append(("firmer", math.inf))
+    return tuple(pairs)
+
+
+def cmd_synth(args) -> int:
+    from ..outputs import check_output
+    from ..signals import read as reading
+    from ..signals.synth import Population, SensorModel, synthesize, truth_path, write_recording, write_truth
+
+    try:
+        fmt = reading.recording_format(args.output, args.format, "--format")
+        check_output(args.output, "-o/--output", None if args.format else dict(reading.EXTENSIONS))
+    except (ValueError, TypeError) as exc:
+        raise UsageError(str(exc)) from None
+    count = args.count
+    if not (str(count).isdigit() and 1 <= int(count) <= 100_000):
+        raise UsageError(f"argument --count: must be an integer in [1, 100000]; got {count!r}")
+    lanes = args.lanes
+    if not (str(lanes).isdigit() and 1 <= int(lanes) <= 64):
+        raise UsageError(f"argument --lanes: must be an integer in [1, 64]; got {lanes!r}")
+    rebounds = args.rebounds
+    if rebounds not in ("0", "1", "2"):
+        raise UsageError(f"argument --rebounds: must be 0, 1 or 2; got {rebounds!r}")
+    clip = (None, None)
+    if args.clip:
+        try:
+            clip = tuple(float(parse_quantity(v, "force")) for v in args.clip.split(","))
+            assert len(clip) == 2 and clip[0] < clip[1]
+        except (ValueError, AssertionError):
+            raise UsageError(f"argument --clip: expected LOW,HIGH in N, LOW < HIGH; got {args.clip!r}") from None
+    if args.velocity is not None and args.drop_height is not None:
+        raise UsageError("give either --velocity or --drop-height, not both")
+    if args.restitution is not None and args.alpha is not None:
+        raise UsageError("give either --restitution or --alpha, not both")
+    sensor_kwargs = dict(
+        rate=_float("--rate", args.rate, "frequency"),
+        noise=_float("--noise", args.noise, "dimensionless", low_inclusive=True, high=1.0),
+        drift=_float("--drift", args.drift, "dimensionless", low=-math.inf),
+        hum_amplitude=_float("--hum", args.hum, "force", low_inclusive=True),
+        hum_frequency=_float("--hum-frequency", args.hum_frequency, "frequency"),
+        adc_bits=int(args.adc_bits) if str(args.adc_bits).isdigit() else -1,
+        clip_low=clip[0], clip_high=clip[1],
+        plate_frequency=_float("--plate-frequency", args.plate_frequency, "frequency", low_inclusive=True),
+        plate_damping=_float("--plate-damping", args.plate_damping, "dimensionless") if args.plate_damping else None,
+        antialias_cutoff=_float("--antialias", args.antialias, "frequency", low_inclusive=True),
+        seed=int(args.seed) if str(args.seed).isdigit() else -1)
+    sensor = _library_call(SensorModel, **sensor_kwargs)
+    height = _float("--drop-height", args.drop_height, "length", high=10.0) if args.velocity is None else None
+    population = _library_call(
+        Population, count=int(count), interval=_float("--interval", args.interval, "time"),
+        mass=_float("--mass", args.mass, "mass"), diameter=_float("--diameter", args.diameter, "length"),
+        modulus=_float("--modulus", args.modulus, "modulus"),
+        poisson=_float("--poisson", args.poisson, "dimensionless", low_inclusive=True, high=0.4999999),
+        classes=_classes_option(args.classes), velocity=_float("--velocity", args.velocity, "velocity"),
+        drop_height=height,
+        restitution=_float("--restitution", args.restitution, "dimensionless", high=1.0)
+        if args.alpha is None else None,
+        alpha=_float("--alpha", args.alpha, "alpha", low_inclusive=True) if args.alpha is not None else None,
+        modulus_spread=_float("--modulus-spread", args.modulus_spread, "dimensionless", low_inclusive=True),
+        mass_spread=_float("--mass-spread", args.mass_spread, "dimensionless", low_inclusive=True),
+        jitter=_float("--jitter", args.jitter, "time", low_inclusive=True), rebounds=int(rebounds),
+        lanes=int(lanes), seed=sensor_kwargs["seed"] + 1)
+    recording, truth = _library_call(synthesize, sensor, population, lanes=int(lanes))
+    path = _library_call(write_recording, recording, args.output, fmt)
+    truth_file = _library_call(write_truth, truth, truth_path(args.output))
+    print(f"{len(truth['impacts'])} impacts ({sum(1 for i in truth['impacts'] if i['rebound'])} rebounds) in "
+          f"{recording.duration:.4g} s at {recording.rate:g} Hz, {len(recording.lanes)} lane(s): written to {path}, "
+          f"truth to {truth_file}")
+    return 0
+
+
+def add_synth_parser(sub) -> None:
+    sy = sub.add_parser("synth", help="a synthetic force-sensor recording with its ground truth",
+                        description="Impacts from the simulator through a sensor model (noise, drift, hum, ADC, "
+                                    "clipping, plate resonance, anti-alias filter, rebounds, fruit spacing, a "
+                                    "population of firmness), written as CSV/NPY/float32/TDMS with FILE.truth.json.")
+    sy.add_argument("-o", "--output", required=True, metavar="FILE", help="the recording (.csv, .npy, .f32, .tdms)")
+    sy.add_argument("--format", metavar="FMT", help="csv, npy, f32 or tdms (default: from the extension)")
+    sensor = sy.add_argument_group("sensor")
+    sensor.add_argument("--rate", default="20000", metavar="HZ", help="sample rate (default 20 kHz)")
+    sensor.add_argument("--noise", default="0.01", metavar="FRACTION",
+                        help="noise sd as a fraction of the median peak force (default 0.01)")
+    sensor.add_argument("--drift", default="0", metavar="N/S", help="baseline drift [N/s] (default 0)")
+    sensor.add_argument("--hum", default="0", metavar="N", help="mains hum amplitude (default 0)")
+    sensor.add_argument("--hum-frequency", default="50", metavar="HZ", help="mains frequency (default 50)")
+    sensor.add_argument("--adc-bits", default="0", metavar="B", help="ADC resolution over --clip (0: none)")
+    sensor.add_argument("--clip", metavar="LOW,HIGH", help="ADC limits [N]: samples beyond are clipped")
+    sensor.add_argument("--plate-frequency", default="0", metavar="HZ", help="plate resonance (0: none)")
+    sensor.add_argument("--plate-damping", metavar="ZETA", help="damping ratio of the plate resonance")
+    sensor.add_argument("--antialias", default="0", metavar="HZ", help="anti-alias low-pass cutoff (0: none)")
+    sensor.add_argument("--seed", default="0", metavar="S", help="random seed (default 0)")
+    fruit = sy.add_argument_group("fruit (default: the paper's Jonathan apple dropped 5 cm)")
+    fruit.add_argument("--count", default="20", metavar="N", help="fruit (default 20)")
+    fruit.add_argument("--interval", default="0.25", metavar="S", help="time between fruit (default 0.25 s)")
+    fruit.add_argument("--jitter", default="0", metavar="S", help="random shift of each fruit (at most interval/2)")
+    fruit.add_argument("--lanes", default="1", metavar="K", help="lanes (default 1)")
+    fruit.add_argument("--drop-height", default="5cm", metavar="H", help="drop height (default 5 cm)")
+    fruit.add_argument("--velocity", metavar="V", help="impact velocity instead of the drop height")
+    fruit.add_argument("--mass", default="115g", metavar="M")
+    fruit.add_argument("--diameter", default="65mm", metavar="D")
+    fruit.add_argument("--modulus", default="3MPa", metavar="E", help="median Young's modulus")
+    fruit.add_argument("--modulus-spread", default="0.15", metavar="SD", help="lognormal sd of E (default 0.15)")
+    fruit.add_argument("--mass-spread", default="0", metavar="SD", help="lognormal sd of the mass (default 0)")
+    fruit.add_argument("--poisson", default="0.37", metavar="NU")
+    fruit.add_argument("--restitution", default="0.577", metavar="E", help="restitution at the drop (default 0.577)")
+    fruit.add_argument("--alpha", metavar="A", help="Hunt–Crossley α instead of the restitution")
+    fruit.add_argument("--rebounds", default="1", metavar="K", help="rebounds followed, 0-2 (default 1)")
+    fruit.add_argument("--classes", default="soft:2.5MPa,medium:3.5MPa,firm", metavar="LABEL:E_MAX,...",
+                       help="firmness classes by E (default soft:2.5MPa,medium:3.5MPa,firm)")
+    sy.set_defaults(func=cmd_synth)
+
+
+# -------------------------------------------------------------------------------------------- stream
+def cmd_stream(args) -> int:
+    from ..signals.analysis import public
+    from ..signals.stream import StreamAnalyzer, iter_chunks, serve
+
+    rate = _float("--rate", args.rate, "frequency")
+    if rate is None:
+        raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
+    if not (str(args.lanes).isdigit() and 1 <= int(args.lanes) <= 256):
+        raise UsageError(f"argument --lanes: must be an integer in [1, 256]; got {args.lanes!r}")
+    lanes = int(args.lanes)
+    source = {"text": "text", "f32": "float32"}.get(args.format)
+    if source is None:
+        raise UsageError(f"argument --format: must be text or f32; got {args.format!r}")
+    port = None
+    if args.listen is not None:
+        if not (str(args.listen).isdigit() and 0 <= int(args.listen) <= 65535):
+            raise UsageError(f"argument --listen: must be a port in [0, 65535]; got {args.listen!r}")
+        port = int(args.listen)
+    settings, analysis = analysis_from(args, rate)
+
+    def emit(impact, _values):
+        report = analysis.report(impact)
+        report["lane"] = f"lane{impact.lane}"
+        sys.stdout.write(_json_line(public(report)) + "\n")
+        sys.stdout.flush()  # one line per impact as soon as it is known
+
+    def problem(message):
+        print(f"{PROG} stream: warning: {message}", file=sys.stderr, flush=True)
+
+    if port is not None:
+        def listening(actual):
+            print(f"{PROG} stream: listening on 127.0.0.1:{actual}", file=sys.stderr, flush=True)
+
+        _library_call(serve, port, rate, lanes, settings, lambda values: None, source=source, on_problem=problem,
+                      on_listening=listening, on_detected=emit) if "on_detected" in serve.__code__.co_varnames \
+            else _serve_with_reports(serve, port, rate, lanes, settings, source, problem, listening, emit)
+        return 0
+    analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, lambda values: None, source=source,
+                             on_problem=problem, on_detected=emit)
+    summary = analyzer.run(iter_chunks(sys.stdin.buffer))
+    print(f"{PROG} stream: {summary['samples']} samples, {summary['impacts']} impacts"
+          + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
+          + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
+          file=sys.stderr)
+    return 130 if summary["interrupted"] == "SIGINT" else 0
+
+
+def _serve_with_reports(serve, port, rate, lanes, settings, source, problem, listening, emit):
+    """``serve`` without an ``on_detected`` hook: wrap its analyzer class for the reports."""
+    from ..signals import stream as streaming
+
+    original = streaming.StreamAnalyzer
+
+    class _Reporting(original):
+        def __init__(self, *args, **kwargs):
+            kwargs["on_detected"] = emit
+            super().__init__(*args, **kwargs)
+
+    streaming.StreamAnalyzer = _Reporting
+    try:
+        _library_call(serve, port, rate, lanes, settings, lambda values: None, source=source, on_problem=problem,
+                      on_listening=listening)
+    finally:
+        streaming.StreamAnalyzer = original
+
+
+def add_stream_parser(sub) -> None:
+    st = sub.add_parser("stream", help="real time: samples in (stdin or TCP), one JSON line per impact out",
+                        description="Read force samples continuously (stdin as text lines or raw float32, or a "
+                                    "TCP socket on localhost) and write one JSON line per impact as soon as it "
+                                    "has ended and its rebound window has closed: the same objects as analyze.")
+    st.add_argument("--rate", metavar="HZ", help="sample rate [Hz] (required)")
+    st.add_argument("--lanes", default="1", metavar="K", help="numbers per sample (default 1)")
+    st.add_argument("--format", default="text", metavar="FMT", help="text (one sample per line) or f32 (raw "
+                                                                     "little-endian float32, lanes interleaved)")
+    st.add_argument("--listen", metavar="PORT", help="serve a TCP socket on 127.0.0.1:PORT instead of stdin")
+    add_analysis_options(st)
+    st.set_defaults(func=cmd_stream)

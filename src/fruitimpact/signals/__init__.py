@@ -1,0 +1,26 @@
+"""Force signals of impact firmness sensors: recordings, reading them from files, and a
+synthetic sensor with a known truth.
+
+* ``recording``: ``Recording``, force lanes [N] sampled together at one rate [Hz].
+* ``read``: ``read_recording(path)`` for CSV, NumPy ``.npy``, raw float32 and NI TDMS files.
+* ``synth``: ``SensorModel``, ``Impact``, ``Population``, ``synthesize`` (recording + truth),
+  ``write_recording``, ``write_truth``.
+
+SI units throughout.  Importing this package loads neither the engine nor SciPy, pyarrow
+or nptdms: each is imported by the function that needs it.
+"""
+
+from .read import read_recording
+from .recording import Recording
+from .synth import (
+    Impact,
+    Population,
+    SensorModel,
+    synthesize,
+    truth_path,
+    write_recording,
+    write_truth,
+)
+
+__all__ = ["Impact", "Population", "Recording", "SensorModel", "read_recording", "synthesize", "truth_path",
+           "write_recording", "write_truth"]

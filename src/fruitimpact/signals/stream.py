@@ -1,0 +1,419 @@
+"""Streaming analysis: bytes in, one dict of indices per impact out (issue 8, item 6; for the CLI).
+
+* ``TextSource``: text, one sample per line, ``lanes`` numbers per line separated by whitespace and/or
+  commas.  A malformed line (wrong count of numbers, something that is not a number, NaN or infinity)
+  is skipped and counted; the first line with each kind of problem is reported through ``on_problem``
+  (one message per kind), the rest only counted.  Blank lines are skipped silently.  A skipped line
+  removes one sample, so later samples move 1/rate earlier.
+* ``Float32Source``: raw little-endian float32, lanes interleaved (sample 0 lane 0, sample 0 lane 1, …).
+  A sample cut by a read boundary waits for the next read; bytes left at the end are reported and
+  dropped.  A NaN or infinite value is replaced by the lane's previous value (0 before any) and reported
+  once, so the timing of later samples is kept.
+* ``StreamAnalyzer``: a ``Detector`` plus ``impact_indices``: each impact becomes one dict (the keys of
+  ``indices.INDEX_KEYS``) passed to ``on_impact``.  ``run(chunks)`` consumes an iterable of byte chunks,
+  and on its end, on SIGTERM or on Ctrl-C (SIGINT) flushes the detector — emitting the impact in
+  progress as ``truncated`` and everything held — before it returns a summary.
+* ``serve(port, ...)``: a TCP server on 127.0.0.1 that takes one client at a time and analyses its bytes
+  as one stream (a fresh analyzer per client: sample indices restart at 0).
+* ``iter_chunks(file)``: the chunks of a binary file object as soon as they arrive (``read1``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import signal
+import socket
+import sys
+import threading
+from collections.abc import Callable, Iterable
+
+import numpy as np
+
+from .detect import DetectedImpact, Detector, DetectorSettings
+from .indices import impact_indices
+
+__all__ = ["Float32Source", "StreamAnalyzer", "TextSource", "iter_chunks", "serve"]
+
+CHUNK_SIZE = 1 << 16
+
+
+def _default_problem(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _lanes(lanes) -> int:
+    if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= 1024:
+        raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
+    return int(lanes)
+
+
+class _Problems:
+    """Counts problems by kind; reports the first of each kind."""
+
+    def __init__(self, on_problem: Callable[[str], None] | None):
+        self.on_problem = on_problem if on_problem is not None else _default_problem
+        self.counts: dict[str, int] = {}
+
+    def add(self, kind: str, message: str, count: int = 1) -> None:
+        first = kind not in self.counts
+        self.counts[kind] = self.counts.get(kind, 0) + count
+        if first:
+            self.on_problem(message + " (skipped; further problems of this kind are only counted)")
+
+
+class TextSource:
+    """Parse text samples (module docstring): ``parse(chunk)`` → float64 array (n, lanes) of the complete
+    lines in ``chunk`` (a partial last line waits for the next chunk); ``finish()`` parses what is left.
+
+    Counters: ``lines`` (non-blank lines seen), ``samples`` (lines accepted), ``malformed`` (lines
+    skipped) and ``problems`` (skipped lines by kind)."""
+
+    def __init__(self, lanes: int = 1, on_problem: Callable[[str], None] | None = None):
+        self.lanes = _lanes(lanes)
+        self._problems = _Problems(on_problem)
+        self._partial = b""
+        self.lines = 0
+        self.samples = 0
+        self.malformed = 0
+        self._line_number = 0
+
+    @property
+    def problems(self) -> dict[str, int]:
+        return dict(self._problems.counts)
+
+    def parse(self, chunk: bytes) -> np.ndarray:
+        data = self._partial + bytes(chunk)
+        cut = data.rfind(b"\n")
+        if cut < 0:
+            self._partial = data
+            return np.empty((0, self.lanes))
+        self._partial = data[cut + 1:]
+        return self._parse_lines(data[:cut + 1])
+
+    def finish(self) -> np.ndarray:
+        data, self._partial = self._partial, b""
+        return self._parse_lines(data) if data.strip() else np.empty((0, self.lanes))
+
+    def _parse_lines(self, data: bytes) -> np.ndarray:
+        text = data.decode("utf-8", errors="replace")
+        raw_lines = text.split("\n")
+        if raw_lines and raw_lines[-1] == "":
+            raw_lines.pop()
+        first_number = self._line_number + 1
+        self._line_number += len(raw_lines)
+        tokens = [line.replace(",", " ").split() for line in raw_lines]
+        lanes = self.lanes
+        # fast path: every non-blank line has the right count and everything parses
+        good = [t for t in tokens if t]
+        self.lines += len(good)
+        if all(len(t) == lanes for t in good):
+            try:
+                values = np.array(good, dtype=float).reshape(len(good), lanes)
+            except ValueError:
+                values = None
+            if values is not None and np.isfinite(values).all():
+                self.samples += len(good)
+                return values
+        rows = []
+        for offset, t in enumerate(tokens):
+            if not t:
+                continue
+            number = first_number + offset
+            if len(t) != lanes:
+                self._bad("count", f"line {number}: expected {lanes} number{'s' if lanes > 1 else ''}, "
+                                   f"got {len(t)}")
+                continue
+            try:
+                row = [float(v) for v in t]
+            except ValueError:
+                bad = next(v for v in t if not _is_float(v))
+                self._bad("number", f"line {number}: not a number: {bad[:40]!r}")
+                continue
+            if not all(math.isfinite(v) for v in row):
+                self._bad("finite", f"line {number}: NaN or infinite value")
+                continue
+            rows.append(row)
+        self.samples += len(rows)
+        return np.array(rows, dtype=float).reshape(len(rows), lanes)
+
+    def _bad(self, kind: str, message: str) -> None:
+        self.malformed += 1
+        self._problems.add(kind, message)
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+class Float32Source:
+    """Parse raw little-endian float32 with ``lanes`` interleaved values per sample (module docstring).
+
+    Counters: ``samples`` (complete samples), ``replaced`` (non-finite values replaced), ``dropped_bytes``
+    (an incomplete final sample) and ``problems`` (by kind)."""
+
+    def __init__(self, lanes: int = 1, on_problem: Callable[[str], None] | None = None):
+        self.lanes = _lanes(lanes)
+        self._problems = _Problems(on_problem)
+        self._partial = b""
+        self._last = np.zeros(self.lanes, dtype=np.float32)
+        self.samples = 0
+        self.replaced = 0
+        self.dropped_bytes = 0
+
+    @property
+    def problems(self) -> dict[str, int]:
+        return dict(self._problems.counts)
+
+    def parse(self, chunk: bytes) -> np.ndarray:
+        data = self._partial + bytes(chunk) if self._partial else bytes(chunk)
+        size = 4 * self.lanes
+        usable = len(data) - len(data) % size
+        self._partial = data[usable:]
+        if usable == 0:
+            return np.empty((0, self.lanes))
+        values = np.frombuffer(data, dtype="<f4", count=usable // 4).reshape(-1, self.lanes)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            values = values.copy()
+            count = int(bad.sum())
+            first = int(np.argmax(bad.any(axis=1)))
+            self.replaced += count
+            self._problems.add("finite", f"sample {self.samples + first}: NaN or infinite value replaced by the "
+                                         f"lane's previous value", count)
+            for lane in range(self.lanes):
+                column = values[:, lane]
+                rows = np.flatnonzero(bad[:, lane])
+                if rows.size:
+                    # forward fill: each bad value takes the last good value before it
+                    good = np.where(~bad[:, lane], np.arange(column.shape[0]), -1)
+                    last_good = np.maximum.accumulate(good)
+                    filled = np.where(last_good >= 0, column[np.maximum(last_good, 0)], self._last[lane])
+                    values[:, lane] = filled
+        self._last = values[-1].copy()
+        self.samples += values.shape[0]
+        return values.astype(np.float64)
+
+    def finish(self) -> np.ndarray:
+        if self._partial:
+            self.dropped_bytes = len(self._partial)
+            self._problems.add("partial", f"the stream ended inside a sample: {len(self._partial)} byte(s) "
+                                          f"dropped ({4 * self.lanes} bytes per sample)")
+            self._partial = b""
+        return np.empty((0, self.lanes))
+
+
+_SOURCES = {"text": TextSource, "float32": Float32Source}
+
+
+class _Interrupted(Exception):
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _SignalGuard:
+    """While active (main thread only): SIGTERM and SIGINT raise ``_Interrupted`` — or, inside a critical
+    section, are remembered and acted on when it ends — so a stream is never cut in the middle of a
+    detector update."""
+
+    def __init__(self):
+        self.pending: int | None = None
+        self.critical = False
+        self._previous: dict = {}
+
+    def _handler(self, signum, frame):
+        if self.critical:
+            self.pending = signum
+        else:
+            raise _Interrupted(signum)
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                self._previous[sig] = signal.signal(sig, self._handler)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+        self._previous.clear()
+        return False
+
+    @contextlib.contextmanager
+    def section(self):
+        self.critical = True
+        try:
+            yield
+        finally:
+            self.critical = False
+
+
+class StreamAnalyzer:
+    """Detector + indices over a byte stream (module docstring).
+
+    Parameters
+    ----------
+    rate : float
+        Sample rate [Hz].
+    lanes : int
+        Numbers per sample.
+    settings : DetectorSettings, optional
+        Detector settings (defaults if None).
+    on_impact : callable, optional
+        Called with each impact's dict of indices (``indices.INDEX_KEYS``), in emission order.  If None,
+        the dicts are collected in ``results``.
+    source : "text" or "float32"
+        Input format (``TextSource`` or ``Float32Source``).
+    on_problem : callable, optional
+        Called with one line per kind of input problem (default: print to stderr).
+    on_detected : callable, optional
+        Also called with each ``DetectedImpact`` and its dict (e.g. for a model fit of its window).
+    """
+
+    def __init__(self, rate: float, lanes: int = 1, settings: DetectorSettings | None = None,
+                 on_impact: Callable[[dict], None] | None = None, *, source: str = "text",
+                 on_problem: Callable[[str], None] | None = None,
+                 on_detected: Callable[[DetectedImpact, dict], None] | None = None):
+        if source not in _SOURCES:
+            raise ValueError(f"source must be one of {', '.join(map(repr, _SOURCES))}; got {source!r}")
+        self.detector = Detector(rate, settings, lanes)
+        self.rate = self.detector.rate
+        self.lanes = self.detector.lanes
+        self.source = _SOURCES[source](self.lanes, on_problem)
+        self.results: list[dict] = []
+        self.on_impact = on_impact if on_impact is not None else self.results.append
+        self.on_detected = on_detected
+        self.impacts = 0
+        self.closed = False
+        self.interrupted: str | None = None
+
+    def feed_bytes(self, chunk: bytes) -> int:
+        """Parse and analyse a chunk of input; returns the number of impacts emitted."""
+        return self.feed(self.source.parse(chunk))
+
+    def feed(self, samples) -> int:
+        """Analyse already parsed samples, shape (n,) or (n, lanes); returns the number of impacts emitted."""
+        if self.closed:
+            raise RuntimeError("this StreamAnalyzer is closed (its stream ended)")
+        return self._emit(self.detector.feed(samples))
+
+    def close(self) -> int:
+        """End of stream: parse what the source holds, flush the detector; idempotent."""
+        if self.closed:
+            return 0
+        count = self._emit(self.detector.feed(self.source.finish()))
+        self.closed = True
+        return count + self._emit(self.detector.flush())
+
+    def _emit(self, impacts: list[DetectedImpact]) -> int:
+        for impact in impacts:
+            values = impact_indices(impact, self.rate)
+            self.impacts += 1
+            if self.on_detected is not None:
+                self.on_detected(impact, values)
+            self.on_impact(values)
+        return len(impacts)
+
+    def run(self, chunks: Iterable[bytes]) -> dict:
+        """Consume ``chunks`` (bytes) to their end, or until SIGTERM/SIGINT (main thread) or
+        KeyboardInterrupt, then ``close()``; returns ``summary()``."""
+        with _SignalGuard() as guard:
+            try:
+                for chunk in chunks:
+                    with guard.section():
+                        self.feed_bytes(chunk)
+                    if guard.pending is not None:
+                        self.interrupted = signal.Signals(guard.pending).name
+                        break
+            except _Interrupted as stop:
+                self.interrupted = signal.Signals(stop.signum).name
+            except KeyboardInterrupt:
+                self.interrupted = "SIGINT"
+            with guard.section():
+                self.close()
+        return self.summary()
+
+    def summary(self) -> dict:
+        """Samples per lane, impacts emitted, input problems by kind, and how the stream ended."""
+        source = self.source
+        return {"samples": self.detector.samples_fed, "impacts": self.impacts,
+                "malformed_lines": getattr(source, "malformed", 0),
+                "replaced_values": getattr(source, "replaced", 0),
+                "dropped_bytes": getattr(source, "dropped_bytes", 0),
+                "problems": source.problems, "interrupted": self.interrupted}
+
+
+def iter_chunks(file, size: int = CHUNK_SIZE):
+    """The chunks of a binary file object as soon as they are available (``read1``), until EOF."""
+    read = getattr(file, "read1", None) or file.read
+    while True:
+        chunk = read(size)
+        if not chunk:
+            return
+        yield chunk
+
+
+def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | None = None,
+          on_impact: Callable[[dict], None] | None = None, *, source: str = "text",
+          on_problem: Callable[[str], None] | None = None, host: str = "127.0.0.1",
+          max_clients: int | None = None, on_listening: Callable[[int], None] | None = None,
+          on_client: Callable[[tuple, dict], None] | None = None,
+          on_detected: Callable[[DetectedImpact, dict], None] | None = None) -> list[dict]:
+    """Listen on ``host``:``port`` (0: any free port) and analyse each client's bytes as one stream, one
+    client at a time, until ``max_clients`` clients were served (None: until SIGTERM/SIGINT).
+
+    ``on_impact``, ``source``, ``on_problem`` and ``on_detected`` are those of ``StreamAnalyzer``;
+    ``on_listening(port)`` is called once the socket listens; ``on_client(address, summary)`` after each
+    client.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
+    the socket is opened.
+    """
+    if isinstance(port, bool) or not isinstance(port, (int, np.integer)) or not 0 <= port <= 65535:
+        raise ValueError(f"port must be an integer in [0, 65535]; got {port!r}")
+    if max_clients is not None and (isinstance(max_clients, bool) or not isinstance(max_clients, (int, np.integer))
+                                    or max_clients < 1):
+        raise ValueError(f"max_clients must be None or an integer >= 1; got {max_clients!r}")
+    StreamAnalyzer(rate, lanes, settings, on_impact, source=source, on_problem=on_problem)  # checks the arguments
+    summaries: list[dict] = []
+    with _SignalGuard() as guard, socket.create_server((host, port)) as server:
+        if on_listening is not None:
+            on_listening(server.getsockname()[1])
+        try:
+            while max_clients is None or len(summaries) < max_clients:
+                connection, address = server.accept()
+                with connection:
+                    analyzer = StreamAnalyzer(rate, lanes, settings, on_impact, source=source,
+                                              on_problem=on_problem, on_detected=on_detected)
+                    summary = _serve_client(analyzer, connection, guard)
+                summaries.append(summary)
+                if on_client is not None:
+                    on_client(address, summary)
+                if summary["interrupted"]:
+                    break
+        except _Interrupted:
+            pass
+    return summaries
+
+
+def _serve_client(analyzer: StreamAnalyzer, connection: socket.socket, guard: _SignalGuard) -> dict:
+    try:
+        while True:
+            chunk = connection.recv(CHUNK_SIZE)
+            if not chunk:
+                break
+            with guard.section():
+                analyzer.feed_bytes(chunk)
+            if guard.pending is not None:
+                analyzer.interrupted = signal.Signals(guard.pending).name
+                break
+    except _Interrupted as stop:
+        analyzer.interrupted = signal.Signals(stop.signum).name
+    except (ConnectionResetError, BrokenPipeError):
+        pass
+    with guard.section():
+        analyzer.close()
+    return analyzer.summary()

@@ -1,0 +1,65 @@
+"""``fruitimpact stream`` writes the same JSON objects as ``analyze`` on the same samples (issue 8, contract
+and acceptance), whatever the size of the reads; malformed text lines are skipped, not fatal.
+The detector-level check on a million samples in random chunks is in tests/test_signals_detect.py."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from conftest import console_script
+
+
+def _reports(text: str) -> list[dict]:
+    rows = [json.loads(line) for line in text.splitlines() if line.strip()]
+    return sorted(rows, key=lambda r: (r["start_time"], r["lane"]))
+
+
+def test_stream_in_random_chunks_equals_analyze(cli, tmp_path):
+    recording = tmp_path / "line.f32"
+    cli.ok("synth", "-o", recording, "--count", "12", "--lanes", "2", "--seed", "5")
+    status, out, err = cli.run("analyze", recording, "--rate", "20000", "--lanes", "2", "--fit", "--drop-height",
+                               "5cm", "--json")
+    assert status == 0, err
+    expected = _reports(out)
+    assert len(expected) >= 24
+    data = recording.read_bytes()
+    # a writer that sends the bytes in random pieces (cutting samples and lanes apart), flushing each
+    feeder = ("import sys, random; random.seed(7); data = open(sys.argv[1], 'rb').read(); i = 0\n"
+              "while i < len(data):\n    n = random.randint(1, 50000); sys.stdout.buffer.write(data[i:i + n]);"
+              " sys.stdout.buffer.flush(); i += n\n")
+    writer = subprocess.Popen([sys.executable, "-c", feeder, str(recording)], stdout=subprocess.PIPE)
+    reader = subprocess.run([console_script(), "stream", "--rate", "20000", "--lanes", "2", "--format", "f32",
+                             "--fit", "--drop-height", "5cm"], stdin=writer.stdout, capture_output=True, text=True,
+                            timeout=300)
+    writer.wait()
+    assert reader.returncode == 0, reader.stderr
+    assert _reports(reader.stdout) == expected
+    assert len(data) % 8 == 0
+
+
+def test_text_stream_skips_malformed_lines_and_reports_them(tmp_path):
+    rng = np.random.default_rng(1)
+    samples = rng.normal(0.0, 0.3, 6000)
+    t = np.arange(400) / 20000.0
+    samples[3000:3400] += 80.0 * np.sin(np.pi * t / t[-1]) ** 1.5  # one pulse
+    lines = [f"{v:.6f}" for v in samples]
+    lines.insert(1000, "not a number")
+    lines.insert(2000, "1.0, 2.0")
+    text = "\n".join(lines) + "\n"
+    result = subprocess.run([console_script(), "stream", "--rate", "20000"], input=text, capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    reports = _reports(result.stdout)
+    assert len(reports) == 1 and abs(reports[0]["peak_force"] - 80.0) < 2.0
+    assert "warning" in result.stderr and "2 malformed lines skipped" in result.stderr
+
+
+def test_stream_refuses_bad_options_in_one_line(cli):
+    assert "--rate" in cli.error("stream")
+    assert "--format" in cli.error("stream", "--rate", "20000", "--format", "csv")
+    assert "--listen" in cli.error("stream", "--rate", "20000", "--listen", "70000")
+    assert "exactly one of" in cli.error("stream", "--rate", "20000", "--fit")
