@@ -133,6 +133,7 @@ def cmd_analyze(args) -> int:
             check_output(args.plot, "--plot", FIGURE_FORMATS)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
+    analysis_from(args, rate if rate is not None else 1e12)  # every option checked before the file is read
     recording = _library_call(read_recording, args.file, rate=rate, column=args.column, format=args.format,
                               lanes=lanes)
     settings, analysis = analysis_from(args, recording.rate)
