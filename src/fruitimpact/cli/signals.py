@@ -134,8 +134,13 @@ def cmd_analyze(args) -> int:
         except ValueError as exc:
             raise UsageError(str(exc)) from None
     analysis_from(args, rate if rate is not None else 1e12)  # every option checked before the file is read
-    recording = _library_call(read_recording, args.file, rate=rate, column=args.column, format=args.format,
-                              lanes=lanes)
+    try:
+        recording = read_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
+    except ValueError as exc:
+        text = str(exc)
+        option = "--rate" if "rate" in text and ("required" in text or "disagree" in text) else \
+            "--column" if "column" in text and args.column else "FILE"
+        raise UsageError(f"argument {option}: {text.replace('give rate= [Hz]', 'give --rate HZ')}") from None
     settings, analysis = analysis_from(args, recording.rate)
     detector = _library_call(Detector, recording.rate, settings, lanes=len(recording.lanes))
     matrix = np.column_stack([recording.lanes[name] for name in recording.lane_names])
