@@ -183,8 +183,10 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     _check_text(inputs, messages)
     _plausibility(inputs, warnings, detail)
 
-    used_matrix = np.where(inputs.given_matrix, inputs.matrix, NUMERIC_DEFAULTS)
-    used = dict(zip(NUMERIC_INPUTS, used_matrix))
+    # an input nobody gave is its default on every row: a fill, not a select over the whole matrix
+    used = {name: (np.where(inputs.given_matrix[j], inputs.matrix[j], NUMERIC_DEFAULTS[j, 0])
+                   if given[name].any() else np.full(rows, NUMERIC_DEFAULTS[j, 0]))
+            for j, name in enumerate(NUMERIC_INPUTS)}
     resolved = presets.resolve(inputs, GROUP_DEFAULTS["restitution"])
     resolved.apply(used, given)
     velocity = np.where(given["velocity"], values["velocity"],
@@ -459,16 +461,20 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
     absorbed = out[:, COLUMN["absorbed_energy"]]
     columns = {"yield_velocity": np.full(rows, np.inf), "permanent_deflection": np.zeros(rows),
                "plastic_work": np.zeros(rows), "viscous_work": absorbed.copy()}
-    share = (1.0 / fruit_modulus) / (1.0 / pair_modulus)  # the fruit's share of the compliance
+    # the fruit's share of the compliance, (1/E_1*) / (1/E*): all of it on a rigid surface
+    share = 1.0 if not layer.any() and np.isinf(used["surface_modulus"]).all() else pair_modulus / fruit_modulus
     if plastic_block is not None:
         computed = ~np.isnan(plastic_block[:, 0])
         for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
             columns[name] = np.where(computed, plastic_block[:, PLASTIC_COLUMNS.index(name)], columns[name])
         share = np.where(computed & layer, plastic_block[:, PLASTIC_COLUMNS.index("fruit_work_share")], share)
     ok = done & np.isfinite(absorbed)
-    for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
-        columns[name] = np.where(ok, columns[name], np.nan)
-    columns["fruit_energy"] = np.where(ok, absorbed * share, np.nan)
+    if ok.all():  # every row an impact (the common case): nothing to blank
+        columns["fruit_energy"] = absorbed * share
+    else:
+        for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
+            columns[name] = np.where(ok, columns[name], np.nan)
+        columns["fruit_energy"] = np.where(ok, absorbed * share, np.nan)
     criterion = inputs.text["criterion"]
     codes = np.asarray([CRITERION_NAMES.index(label) if label in CRITERION_NAMES else 0
                         for label in criterion.labels], dtype=np.int8)[criterion.codes] \

@@ -96,6 +96,42 @@ def check_choice(name: str, value, registry) -> str:
     return value
 
 
+def check_number(name: str, value, *, owner: str = "", low=None, low_inclusive: bool = True, high=None,
+                 high_inclusive: bool = False, optional: bool = False):
+    """A finite float in a range (None passes when ``optional``), else ``InputError`` naming ``name``
+    (``owner.name`` in the message): the check of settings objects outside the table of quantities."""
+    if value is None and optional:
+        return None
+    label = f"{owner}.{name}" if owner else name
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputError(f"{label} must be a number; got {value!r}", name)
+    value = float(value)
+    ok = math.isfinite(value)
+    if ok and low is not None:
+        ok = value >= low if low_inclusive else value > low
+    if ok and high is not None:
+        ok = value <= high if high_inclusive else value < high
+    if not ok:
+        bounds = []
+        if low is not None:
+            bounds.append(f"{'>=' if low_inclusive else '>'} {low:g}")
+        if high is not None:
+            bounds.append(f"{'<=' if high_inclusive else '<'} {high:g}")
+        rule = " and ".join(bounds)
+        raise InputError(f"{label} must be a finite number{' ' + rule if rule else ''}; got {value!r}", name)
+    return value
+
+
+def check_integer(name: str, value, low: int, high: int | None = None, *, owner: str = "") -> int:
+    """An integer in [low, high] (``high`` None: no upper bound), else ``InputError`` naming ``name``."""
+    label = f"{owner}.{name}" if owner else name
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low \
+            or (high is not None and value > high):
+        allowed = f"in [{low}, {high}]" if high is not None else f">= {low}"
+        raise InputError(f"{label} must be an integer {allowed}; got {value!r}", name)
+    return int(value)
+
+
 def conflict_message(names) -> str:
     """``give either velocity or drop_height, not both`` (or one of three)."""
     names = list(names)

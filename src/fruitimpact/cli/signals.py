@@ -413,8 +413,7 @@ def cmd_stream(args) -> int:
             print(f"{PROG} stream: listening on 127.0.0.1:{actual}", file=sys.stderr, flush=True)
 
         _library_call(serve, port, rate, lanes, settings, lambda values: None, source=source, on_problem=problem,
-                      on_listening=listening, on_detected=emit) if "on_detected" in serve.__code__.co_varnames \
-            else _serve_with_reports(serve, port, rate, lanes, settings, source, problem, listening, emit)
+                      on_listening=listening, on_detected=emit)
         return 0
     analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, lambda values: None, source=source,
                              on_problem=problem, on_detected=emit)
@@ -424,25 +423,6 @@ def cmd_stream(args) -> int:
           + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
           file=sys.stderr)
     return 130 if summary["interrupted"] == "SIGINT" else 0
-
-
-def _serve_with_reports(serve, port, rate, lanes, settings, source, problem, listening, emit):
-    """``serve`` without an ``on_detected`` hook: wrap its analyzer class for the reports."""
-    from ..signals import stream as streaming
-
-    original = streaming.StreamAnalyzer
-
-    class _Reporting(original):
-        def __init__(self, *args, **kwargs):
-            kwargs["on_detected"] = emit
-            super().__init__(*args, **kwargs)
-
-    streaming.StreamAnalyzer = _Reporting
-    try:
-        _library_call(serve, port, rate, lanes, settings, lambda values: None, source=source, on_problem=problem,
-                      on_listening=listening)
-    finally:
-        streaming.StreamAnalyzer = original
 
 
 def add_stream_parser(sub) -> None:

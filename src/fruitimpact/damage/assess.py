@@ -29,14 +29,24 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
     ``bruise_width`` of every row (arrays of the table's length; NaN where no criterion applies or
     the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``."""
     rows = criterion.shape[0]
-    nan = np.full(rows, np.nan)
-    out = {name: nan.copy() for name in ("max_shear_stress", "bruise_margin", "bruised", "bruise_volume",
-                                         "bruise_depth", "bruise_width")}
+    out = {name: np.full(rows, np.nan) for name in ("bruise_margin", "bruised", "bruise_volume", "bruise_depth",
+                                                   "bruise_width")}
     # laws with a force at first touch (Kelvin–Voigt) have no finite Hertz pressure: no stress criterion there
     finite = valid & np.isfinite(peak_pressure) & np.isfinite(fruit_energy)
     shear_ok = finite & (poisson >= 0.0) & (poisson <= 0.5)
-    if shear_ok.any():
-        out["max_shear_stress"][shear_ok] = bruise.max_shear_stress(peak_pressure[shear_ok], poisson[shear_ok])
+    everywhere = bool(shear_ok.all())
+    nu = poisson if everywhere else poisson[shear_ok]
+    if nu.size and nu.min() == nu.max():  # one fruit material: τ_max/p0 once, not a sort of every row
+        shear = float(bruise.hertz_max_shear(float(nu[0]))[0]) * (peak_pressure if everywhere else
+                                                                    peak_pressure[shear_ok])
+    else:
+        shear = bruise.max_shear_stress(peak_pressure if everywhere else peak_pressure[shear_ok], nu) \
+            if nu.size else np.empty(0)
+    if everywhere:
+        out["max_shear_stress"] = np.asarray(shear, dtype=float)
+    else:
+        out["max_shear_stress"] = np.full(rows, np.nan)
+        out["max_shear_stress"][shear_ok] = shear
     for code, name in enumerate(CRITERION_NAMES):
         if name == "none":
             continue

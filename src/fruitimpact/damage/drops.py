@@ -42,12 +42,6 @@ _IMPACT_FIELDS = ("velocity", "restitution", "exit_velocity", "peak_force", "tim
                   "bruise_depth", "bruise_width")
 
 
-def evaluation_of(inputs, messages):
-    from ..batch import evaluate_inputs
-
-    return evaluate_inputs(inputs, messages, detail=True)
-
-
 def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = REST_HEIGHT, **inputs) -> dict:
     """The sequence of impacts of a fruit dropped from ``drop_height`` [m] onto a surface.
 
@@ -73,6 +67,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         ``bruised`` (any impact), ``bruise_volume`` (accumulated), ``rest_time``,
         ``status`` and ``message``, ``warnings``.
     """
+    from ..batch import evaluate_inputs
     from ..inputs import read_columns
     from ..quantities import INPUTS
     from ..validation import InputError
@@ -91,7 +86,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     row = {name: value for name, value in inputs.items() if value is not None}
     row["drop_height"] = drop_height
     read, messages = read_columns({name: [value] for name, value in row.items()})
-    first = evaluation_of(read, messages)
+    first = evaluate_inputs(read, messages, detail=True)
     if first.status[0] == 3:  # invalid: the one-line refusal, naming the argument
         raise InputError(messages.text(0), messages.argument(0))
     height = float(first.columns["drop_height"][0])
@@ -123,7 +118,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
                 warnings.append(f"stopped after {max_impacts} impacts while the fruit still rebounds "
                                 f"{rebound * rebound / (2.0 * STANDARD_GRAVITY) * 1e3:.3g} mm")
             break
-        time += contact(columns) + 2.0 * rebound / STANDARD_GRAVITY
+        time += columns["contact_duration"] + 2.0 * rebound / STANDARD_GRAVITY
         velocity = rebound
         next_row = {**row, "velocity": velocity}
         next_row.pop("drop_height")
@@ -134,7 +129,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
             next_row["diameter"] = 2.0 * flattened
         read, messages = read_columns({name: [value] for name, value in next_row.items()})
-        result = evaluation_of(read, messages)
+        result = evaluate_inputs(read, messages, detail=True)
         if result.status[0] == 3:
             status, message = "failed", f"impact {len(impacts) + 1}: {messages.text(0)}"
             break
@@ -157,10 +152,6 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         "bruise_volume": None if criterion == "none" else float(np.nansum(volumes)),
         "rest_time": rest, "status": status, "message": message, "warnings": warnings,
     }
-
-
-def contact(columns: dict) -> float:
-    return columns["contact_duration"]
 
 
 def _contact_modulus(evaluation) -> float:

@@ -167,74 +167,62 @@ def _unload_slope(F, p):
 
 
 @nb.njit(**_JIT)
-def speed_of_energy(mass, c, energy):
-    """v ≥ 0 with m v² r(c v) = energy (loading: v toward the surface) [m/s].
+def _invert_first_integral(q, sign):
+    """y ≥ 0 with y² r(sign · y) = q: the loading (sign +1, y − ln(1 + y) = q) or unloading
+    (sign −1, y ∈ (0, 1), −y − ln(1 − y) = q) first integral in y = c |v|.
 
-    In y = c v: y − ln(1 + y) = q, q = c² energy / m.  A start from the inverse series
-    (y = s + s²/3 + s³/36 − s⁴/270, s = √(2q), for q < 1) or from the fixed point
-    y = q + ln(1 + y) (q ≥ 1), then Halley steps (cubic convergence: two or three)."""
-    if energy <= 0.0:
-        return 0.0
-    if c == 0.0:
-        return math.sqrt(2.0 * energy / mass)
-    q = c * c * energy / mass
+    A start from the inverse series y = s + sign s²/3 + s³/36 − sign s⁴/270 (s = √(2q), q < 1; for
+    q < 1e-8 the series is exact to rounding and is returned), or from a fixed point for q ≥ 1
+    (y = q + ln(1 + y) loading, y = 1 − exp(−q − y) unloading), then Halley steps (cubic convergence:
+    two or three), kept inside the domain."""
     if q < 1.0:
         root = math.sqrt(2.0 * q)
-        y = root * (1.0 + root * (1.0 / 3.0 + root * (1.0 / 36.0 - root / 270.0)))
+        y = root * (1.0 + root * (sign / 3.0 + root * (1.0 / 36.0 - sign * root / 270.0)))
         if q < 1e-8:  # the series' next term is ~s⁵/4320: below rounding here, and Halley would cancel
-            return y / c
-    else:
+            return y
+    elif sign > 0.0:
         y = q + math.log1p(q + math.log1p(q))
         y = q + math.log1p(y)
-    for _ in range(30):
-        f = y * y * r_func(y) - q
-        d1 = y / (1.0 + y)
-        d2 = 1.0 / ((1.0 + y) * (1.0 + y))
+    else:
+        y = -math.expm1(-1.0 - q)
+        y = -math.expm1(-q - y)
+    if sign < 0.0 and not 0.0 < y < 1.0:
+        y = 0.5
+    for _ in range(60):
+        f = y * y * r_func(sign * y) - q
+        one = 1.0 + sign * y
+        d1 = y / one
+        d2 = 1.0 / (one * one)
         step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
         y_new = y - step
         if not y_new > 0.0:
             y_new = 0.5 * y
+        elif sign < 0.0 and not y_new < 1.0:  # unloading: stay below 1 (bisect towards it)
+            y_new = 0.5 * (y + 1.0)
         y = y_new
         if abs(step) <= 4e-16 * y:
             break
-    return y / c
+    return y
 
 
 @nb.njit(**_JIT)
-def rebound_speed_of_energy(mass, c, energy):
-    """w ≥ 0 with m w² r(−c w) = energy (unloading: v = −w away from the surface) [m/s].
-
-    In y = c w ∈ (0, 1): −y − ln(1 − y) = q.  A start from the inverse series
-    (y = s − s²/3 + s³/36 + s⁴/270, s = √(2q), for q < 1) or from y = 1 − exp(−1 − q) (q ≥ 1),
-    then Halley steps."""
+def speed_of_energy(mass, c, energy):
+    """v ≥ 0 with m v² r(c v) = energy (loading: v toward the surface) [m/s]."""
     if energy <= 0.0:
         return 0.0
     if c == 0.0:
         return math.sqrt(2.0 * energy / mass)
-    q = c * c * energy / mass
-    if q < 1.0:
-        root = math.sqrt(2.0 * q)
-        y = root * (1.0 + root * (-1.0 / 3.0 + root * (1.0 / 36.0 + root / 270.0)))
-        if q < 1e-8:
-            return y / c
-    else:
-        y = -math.expm1(-1.0 - q)
-        y = -math.expm1(-q - y)
-    if not 0.0 < y < 1.0:
-        y = 0.5
-    for _ in range(60):
-        f = y * y * r_func(-y) - q
-        one_minus = 1.0 - y
-        d1 = y / one_minus
-        d2 = 1.0 / (one_minus * one_minus)
-        step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
-        y_new = y - step
-        if not 0.0 < y_new < 1.0:  # keep inside (0, 1): bisect towards the side the step points to
-            y_new = 0.5 * (y + (1.0 if y_new >= 1.0 else 0.0))
-        y = y_new
-        if abs(step) <= 4e-16 * y:
-            break
-    return y / c
+    return _invert_first_integral(c * c * energy / mass, 1.0) / c
+
+
+@nb.njit(**_JIT)
+def rebound_speed_of_energy(mass, c, energy):
+    """w ≥ 0 with m w² r(−c w) = energy (unloading: v = −w away from the surface) [m/s]."""
+    if energy <= 0.0:
+        return 0.0
+    if c == 0.0:
+        return math.sqrt(2.0 * energy / mass)
+    return _invert_first_integral(c * c * energy / mass, -1.0) / c
 
 
 @nb.njit(**_JIT)

@@ -83,121 +83,13 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
+from .filters import butterworth_sos, solve_small
+from .settings import DetectorSettings
+
 __all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
 
 # ---------------------------------------------------------------------------------------------------------
 # Settings
-
-
-@dataclass(frozen=True)
-class DetectorSettings:
-    """Settings of the impact detector (SI units; defaults suit fruit on a force plate at 10–50 kHz).
-
-    Attributes
-    ----------
-    baseline_time_constant : float
-        τ_b [s] of the baseline (zero/drift level and slope) estimate over quiet samples. Default 0.05.
-    noise_time_constant : float
-        [s] of the robust running noise σ over quiet samples. Default 0.5.
-    warmup : float
-        [s] learnt at the start (and after an overlong impact) before any onset; ≥ 16 samples. Default 0.05.
-    k_on : float
-        Onset threshold in σ (hysteresis high). Default 6.
-    k_off : float
-        Offset threshold in σ, 0 < k_off < k_on (hysteresis low). Default 3.
-    threshold_floor : float
-        Absolute floor [N] of the onset threshold (the offset floor is scaled by k_off/k_on); keeps a
-        noise-free or quantised quiet signal (σ = 0) from triggering. Default 0.1 N.
-    offset_hold : float
-        [s] the signal must stay below the offset threshold to end an impact (≥ 1 sample). Default 0.5e-3.
-    min_duration : float
-        Shortest contact kept [s] (end − start + 1 samples, ≥ 1 sample). Default 0.5e-3.
-    max_duration : float
-        Longest contact [s]: longer ones are ended (``overlong``) and the baseline is re-learnt. Default 0.1.
-    pre_trigger, post_trigger : float
-        Margins [s] kept in the window before the onset and after the end. Default 2e-3 each.
-    rebound_window : float
-        [s] from the previous impact's end within which a smaller impact is its rebound; also the
-        time an impact is held before emission. 0 disables rebound detection. Default 0.1.
-    hum_frequency : float or None
-        Mains frequency [Hz] (50 or 60) of the hum to remove; None (default): no hum removal.
-    hum_q : float
-        Q of the hum notch (−3 dB bandwidth ≈ hum_frequency/Q; the canceller settles in ≈ Q/(π f) s).
-        Default 10.
-    hum_harmonics : tuple of int
-        Harmonics of hum_frequency removed (ascending, at most 4), e.g. (1, 3). Default (1,).
-    lowpass_cutoff : float or None
-        −3 dB frequency [Hz] of the causal Butterworth low-pass; None (default): no low-pass.
-    lowpass_order : int
-        Order of the low-pass, 1–8. Default 4.
-    clip_low, clip_high : float or None
-        The acquisition's limits [N, raw sample units]: a sample at or beyond them during an impact
-        flags it ``clipped``. Default None (not checked).
-    """
-
-    baseline_time_constant: float = 0.05
-    noise_time_constant: float = 0.5
-    warmup: float = 0.05
-    k_on: float = 6.0
-    k_off: float = 3.0
-    threshold_floor: float = 0.1
-    offset_hold: float = 0.5e-3
-    min_duration: float = 0.5e-3
-    max_duration: float = 0.1
-    pre_trigger: float = 2e-3
-    post_trigger: float = 2e-3
-    rebound_window: float = 0.1
-    hum_frequency: float | None = None
-    hum_q: float = 10.0
-    hum_harmonics: tuple = (1,)
-    lowpass_cutoff: float | None = None
-    lowpass_order: int = 4
-    clip_low: float | None = None
-    clip_high: float | None = None
-
-    def __post_init__(self):
-        def number(name, low=None, high=None, low_open=True, high_open=True, optional=False):
-            value = getattr(self, name)
-            if value is None and optional:
-                return
-            bounds = f"{'(' if low_open else '['}{low if low is not None else '-inf'}, " \
-                     f"{high if high is not None else 'inf'}{')' if high_open else ']'}"
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-                raise ValueError(f"{name} must be a number in {bounds}; got {value!r}")  # noqa: TRY004 (project rule)
-            value = float(value)
-            ok = math.isfinite(value)
-            if ok and low is not None:
-                ok = value > low if low_open else value >= low
-            if ok and high is not None:
-                ok = value < high if high_open else value <= high
-            if not ok:
-                raise ValueError(f"{name} must be a finite number in {bounds}; got {value!r}")
-
-        for name in ("baseline_time_constant", "noise_time_constant", "warmup", "offset_hold", "min_duration",
-                     "max_duration", "k_on"):
-            number(name, 0)
-        number("k_off", 0, self.k_on)
-        for name in ("threshold_floor", "pre_trigger", "post_trigger", "rebound_window"):
-            number(name, 0, low_open=False)
-        number("rebound_window", 0, 60.0, low_open=False, high_open=False)
-        number("max_duration", self.min_duration, 60.0, high_open=False)
-        number("hum_frequency", 0, optional=True)
-        number("hum_q", 0.5)
-        number("lowpass_cutoff", 0, optional=True)
-        number("clip_low", optional=True)
-        number("clip_high", optional=True)
-        if self.clip_low is not None and self.clip_high is not None and not self.clip_low < self.clip_high:
-            raise ValueError(f"clip_high must be > clip_low = {self.clip_low}; got {self.clip_high!r}")
-        order = self.lowpass_order
-        if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 8:
-            raise ValueError(f"lowpass_order must be an integer in [1, 8]; got {order!r}")
-        harmonics = self.hum_harmonics
-        if (not isinstance(harmonics, (tuple, list)) or not 1 <= len(harmonics) <= 4
-                or any(isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= 16
-                       for k in harmonics)
-                or any(b <= a for a, b in itertools.pairwise(harmonics))):
-            raise ValueError(f"hum_harmonics must be 1 to 4 ascending integers in [1, 16]; got {harmonics!r}")
-        object.__setattr__(self, "hum_harmonics", tuple(int(k) for k in harmonics))
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -291,29 +183,6 @@ class DetectedImpact:
 
 
 # ---------------------------------------------------------------------------------------------------------
-# Low-pass design (NumPy only)
-
-
-def butterworth_sos(cutoff: float, order: int, rate: float) -> np.ndarray:
-    """Second-order sections (rows b0, b1, b2, 1, a1, a2, SciPy's layout) of a causal digital Butterworth
-    low-pass of ``order`` with its −3 dB point at ``cutoff`` [Hz] for ``rate`` [Hz]: the analogue
-    prototype's pole pairs at angles π(2k − 1)/(2N) from the imaginary axis, bilinear transform with
-    the cutoff prewarped (K = tan(π f_c/rate)); each section has unit gain at DC."""
-    if not 0 < cutoff < rate / 2:
-        raise ValueError(f"lowpass_cutoff must be in (0, rate/2) = (0, {rate / 2:g}) Hz; got {cutoff!r}")
-    k = math.tan(math.pi * cutoff / rate)
-    rows = []
-    for j in range(order // 2):
-        q = 1.0 / (2.0 * math.sin(math.pi * (2 * j + 1) / (2 * order)))
-        norm = 1.0 / (1.0 + k / q + k * k)
-        b0 = k * k * norm
-        rows.append([b0, 2 * b0, b0, 1.0, 2.0 * (k * k - 1.0) * norm, (1.0 - k / q + k * k) * norm])
-    if order % 2:
-        rows.append([k / (1 + k), k / (1 + k), 0.0, 1.0, (k - 1) / (k + 1), 0.0])
-    return np.array(rows, dtype=float)
-
-
-# ---------------------------------------------------------------------------------------------------------
 # State layout (per lane).  Floats in F, integers in I; the FIFO of ended impacts waiting for emission
 # follows the fixed fields (FIFO_F floats and FIFO_I integers per slot).
 
@@ -348,34 +217,6 @@ CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / 
 MAD_TO_SIGMA = 1.482602218505602
 
 _JIT = {"cache": True, "error_model": "numpy"}
-
-
-@nb.njit(**_JIT)
-def _solve(a, b):
-    """Solve the small symmetric system a x = b (Gaussian elimination with partial pivoting, in place)."""
-    n = b.shape[0]
-    for col in range(n):
-        piv = col
-        for row in range(col + 1, n):
-            if abs(a[row, col]) > abs(a[piv, col]):
-                piv = row
-        if a[piv, col] == 0.0:
-            return False
-        if piv != col:
-            for k in range(n):
-                a[col, k], a[piv, k] = a[piv, k], a[col, k]
-            b[col], b[piv] = b[piv], b[col]
-        for row in range(col + 1, n):
-            f = a[row, col] / a[col, col]
-            for k in range(col, n):
-                a[row, k] -= f * a[col, k]
-            b[row] -= f * b[col]
-    for col in range(n - 1, -1, -1):
-        s = b[col]
-        for k in range(col + 1, n):
-            s -= a[col, k] * b[k]
-        b[col] = s / a[col, col]
-    return True
 
 
 @nb.njit(**_JIT)
@@ -428,7 +269,7 @@ def _warm_fit(lane, gi, F, I, R, WY, WC, WS, harm, nh, L):
                 rhs[r] += x[r] * y[i]
                 for c in range(p):
                     a[r, c] += x[r] * x[c]
-        if not _solve(a, rhs):
+        if not solve_small(a, rhs, p):
             rhs[:] = 0.0
             rhs[0] = np.median(y)
         level = rhs[0]

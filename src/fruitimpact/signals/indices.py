@@ -48,6 +48,7 @@ import numba as nb
 import numpy as np
 
 from .detect import DetectedImpact
+from .filters import solve_small
 
 __all__ = ["FALL_HIGH", "FALL_LOW", "INDEX_KEYS", "RISE_CURVATURE", "RISE_HIGH", "RISE_LOW", "impact_indices"]
 
@@ -75,6 +76,15 @@ _JIT = {"cache": True, "error_model": "numpy"}
 
 
 @nb.njit(**_JIT)
+def _edge_curvature(k, t_ref, sign, tc, beta):
+    """g = 1 − β (|k − t_ref| / tc)^2.5 beyond t_ref on the edge's side (β = 0: 1), at least 0.2."""
+    if not beta > 0.0:
+        return 1.0
+    tau = (k - t_ref) * sign
+    return max(1.0 - beta * (tau / tc) ** 2.5 if tau > 0.0 else 1.0, 0.2)
+
+
+@nb.njit(**_JIT)
 def _edge_zero(w, lo, hi, sign, t_ref, tc, beta):
     """Zero of the weighted line fit of u/g = (w^(2/3))/g against the sample number over w[lo..hi]
     (inclusive), g = 1 − β (|k − t_ref| / tc)^2.5 (β = 0: none).  NaN if the fit is impossible."""
@@ -86,12 +96,7 @@ def _edge_zero(w, lo, hi, sign, t_ref, tc, beta):
         if f <= 0.0:
             continue
         u = f ** (2.0 / 3.0)
-        gk = 1.0
-        if beta > 0.0:
-            tau = (k - t_ref) * sign
-            if tau > 0.0:
-                gk = 1.0 - beta * (tau / tc) ** 2.5
-            gk = max(gk, 0.2)
+        gk = _edge_curvature(k, t_ref, sign, tc, beta)
         weight = u * gk * gk
         sw += weight
         st += weight * k
@@ -107,12 +112,7 @@ def _edge_zero(w, lo, hi, sign, t_ref, tc, beta):
         if f <= 0.0:
             continue
         u = f ** (2.0 / 3.0)
-        gk = 1.0
-        if beta > 0.0:
-            tau = (k - t_ref) * sign
-            if tau > 0.0:
-                gk = 1.0 - beta * (tau / tc) ** 2.5
-            gk = max(gk, 0.2)
+        gk = _edge_curvature(k, t_ref, sign, tc, beta)
         weight = u * gk * gk
         num += weight * (k - tm) * (u / gk - um)
         den += weight * (k - tm) * (k - tm)
@@ -151,29 +151,10 @@ def _peak_fit(w, m, h1, h2, degree):
             b[r] += weight * pw[r] * w[k]
             for c in range(p):
                 a[r, c] += weight * pw[r] * pw[c]
-    # Gaussian elimination on the p × p block
-    for col in range(p):
-        piv = col
-        for row in range(col + 1, p):
-            if abs(a[row, col]) > abs(a[piv, col]):
-                piv = row
-        if a[piv, col] == 0.0:
-            return w[m], float(m)
-        if piv != col:
-            for c in range(p):
-                a[col, c], a[piv, c] = a[piv, c], a[col, c]
-            b[col], b[piv] = b[piv], b[col]
-        for row in range(col + 1, p):
-            f = a[row, col] / a[col, col]
-            for c in range(col, p):
-                a[row, c] -= f * a[col, c]
-            b[row] -= f * b[col]
+    if not solve_small(a, b, p):
+        return w[m], float(m)
     coef = np.zeros(5)
-    for col in range(p - 1, -1, -1):
-        s = b[col]
-        for c in range(col + 1, p):
-            s -= a[col, c] * coef[c]
-        coef[col] = s / a[col, col]
+    coef[:p] = b[:p]
     xlo = (lo - m) / scale
     xhi = (hi - m) / scale
     # the maximum: Newton on the derivative from x = 0 (the largest sample), kept inside the window

@@ -62,7 +62,20 @@ class _Problems:
             self.on_problem(message + " (skipped; further problems of this kind are only counted)")
 
 
-class TextSource:
+class _Source:
+    """What both sources keep: the lane count, the problems seen (by kind) and a partial record."""
+
+    def __init__(self, lanes: int = 1, on_problem: Callable[[str], None] | None = None):
+        self.lanes = _lanes(lanes)
+        self._problems = _Problems(on_problem)
+        self._partial = b""
+
+    @property
+    def problems(self) -> dict[str, int]:
+        return dict(self._problems.counts)
+
+
+class TextSource(_Source):
     """Parse text samples (module docstring): ``parse(chunk)`` → float64 array (n, lanes) of the complete
     lines in ``chunk`` (a partial last line waits for the next chunk); ``finish()`` parses what is left.
 
@@ -70,17 +83,11 @@ class TextSource:
     skipped) and ``problems`` (skipped lines by kind)."""
 
     def __init__(self, lanes: int = 1, on_problem: Callable[[str], None] | None = None):
-        self.lanes = _lanes(lanes)
-        self._problems = _Problems(on_problem)
-        self._partial = b""
+        super().__init__(lanes, on_problem)
         self.lines = 0
         self.samples = 0
         self.malformed = 0
         self._line_number = 0
-
-    @property
-    def problems(self) -> dict[str, int]:
-        return dict(self._problems.counts)
 
     def parse(self, chunk: bytes) -> np.ndarray:
         data = self._partial + bytes(chunk)
@@ -150,24 +157,18 @@ def _is_float(text: str) -> bool:
     return True
 
 
-class Float32Source:
+class Float32Source(_Source):
     """Parse raw little-endian float32 with ``lanes`` interleaved values per sample (module docstring).
 
     Counters: ``samples`` (complete samples), ``replaced`` (non-finite values replaced), ``dropped_bytes``
     (an incomplete final sample) and ``problems`` (by kind)."""
 
     def __init__(self, lanes: int = 1, on_problem: Callable[[str], None] | None = None):
-        self.lanes = _lanes(lanes)
-        self._problems = _Problems(on_problem)
-        self._partial = b""
+        super().__init__(lanes, on_problem)
         self._last = np.zeros(self.lanes, dtype=np.float32)
         self.samples = 0
         self.replaced = 0
         self.dropped_bytes = 0
-
-    @property
-    def problems(self) -> dict[str, int]:
-        return dict(self._problems.counts)
 
     def parse(self, chunk: bytes) -> np.ndarray:
         data = self._partial + bytes(chunk) if self._partial else bytes(chunk)

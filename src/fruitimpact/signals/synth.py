@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from ..constants import STANDARD_GRAVITY
-from ..validation import InputError
+from ..validation import InputError, check_integer, check_number
 from .read import _column, recording_format
 from .recording import Recording
 
@@ -56,38 +56,13 @@ _NODES = 129
 TAIL = 0.02
 
 
-def _number(owner: str, name: str, value, *, low=None, low_inclusive=True, high=None, high_inclusive=False,
-            optional=False):
-    """A finite float checked against a range; None passes when ``optional``."""
-    if value is None and optional:
-        return None
-    label = f"{owner}.{name}" if owner else name
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InputError(f"{label} must be a number; got {value!r}", name)
-    value = float(value)
-    ok = math.isfinite(value)
-    if ok and low is not None:
-        ok = value >= low if low_inclusive else value > low
-    if ok and high is not None:
-        ok = value <= high if high_inclusive else value < high
-    if not ok:
-        bounds = []
-        if low is not None:
-            bounds.append(f"{'>=' if low_inclusive else '>'} {low:g}")
-        if high is not None:
-            bounds.append(f"{'<=' if high_inclusive else '<'} {high:g}")
-        rule = " and ".join(bounds)
-        raise InputError(f"{label} must be a finite number{' ' + rule if rule else ''}; got {value!r}", name)
-    return value
+def _number(owner: str, name: str, value, **bounds):
+    """``validation.check_number`` with the settings object's name in the message."""
+    return check_number(name, value, owner=owner, **bounds)
 
 
 def _integer(owner: str, name: str, value, low: int, high: int | None = None) -> int:
-    label = f"{owner}.{name}" if owner else name
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low \
-            or (high is not None and value > high):
-        allowed = f"in [{low}, {high}]" if high is not None else f">= {low}"
-        raise InputError(f"{label} must be an integer {allowed}; got {value!r}", name)
-    return int(value)
+    return check_integer(name, value, low, high, owner=owner)
 
 
 def _seed(owner: str, value):

@@ -1,0 +1,111 @@
+"""Settings of the impact detector (``signals.detect``): what it tracks, its thresholds and windows,
+each value checked at construction with a one-line ``ValueError`` naming it and its allowed range."""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..validation import check_number
+
+__all__ = ["DetectorSettings"]
+
+
+@dataclass(frozen=True)
+class DetectorSettings:
+    """Settings of the impact detector (SI units; defaults suit fruit on a force plate at 10–50 kHz).
+
+    Attributes
+    ----------
+    baseline_time_constant : float
+        τ_b [s] of the baseline (zero/drift level and slope) estimate over quiet samples. Default 0.05.
+    noise_time_constant : float
+        [s] of the robust running noise σ over quiet samples. Default 0.5.
+    warmup : float
+        [s] learnt at the start (and after an overlong impact) before any onset; ≥ 16 samples. Default 0.05.
+    k_on : float
+        Onset threshold in σ (hysteresis high). Default 6.
+    k_off : float
+        Offset threshold in σ, 0 < k_off < k_on (hysteresis low). Default 3.
+    threshold_floor : float
+        Absolute floor [N] of the onset threshold (the offset floor is scaled by k_off/k_on); keeps a
+        noise-free or quantised quiet signal (σ = 0) from triggering. Default 0.1 N.
+    offset_hold : float
+        [s] the signal must stay below the offset threshold to end an impact (≥ 1 sample). Default 0.5e-3.
+    min_duration : float
+        Shortest contact kept [s] (end − start + 1 samples, ≥ 1 sample). Default 0.5e-3.
+    max_duration : float
+        Longest contact [s]: longer ones are ended (``overlong``) and the baseline is re-learnt. Default 0.1.
+    pre_trigger, post_trigger : float
+        Margins [s] kept in the window before the onset and after the end. Default 2e-3 each.
+    rebound_window : float
+        [s] from the previous impact's end within which a smaller impact is its rebound; also the
+        time an impact is held before emission. 0 disables rebound detection. Default 0.1.
+    hum_frequency : float or None
+        Mains frequency [Hz] (50 or 60) of the hum to remove; None (default): no hum removal.
+    hum_q : float
+        Q of the hum notch (−3 dB bandwidth ≈ hum_frequency/Q; the canceller settles in ≈ Q/(π f) s).
+        Default 10.
+    hum_harmonics : tuple of int
+        Harmonics of hum_frequency removed (ascending, at most 4), e.g. (1, 3). Default (1,).
+    lowpass_cutoff : float or None
+        −3 dB frequency [Hz] of the causal Butterworth low-pass; None (default): no low-pass.
+    lowpass_order : int
+        Order of the low-pass, 1–8. Default 4.
+    clip_low, clip_high : float or None
+        The acquisition's limits [N, raw sample units]: a sample at or beyond them during an impact
+        flags it ``clipped``. Default None (not checked).
+    """
+
+    baseline_time_constant: float = 0.05
+    noise_time_constant: float = 0.5
+    warmup: float = 0.05
+    k_on: float = 6.0
+    k_off: float = 3.0
+    threshold_floor: float = 0.1
+    offset_hold: float = 0.5e-3
+    min_duration: float = 0.5e-3
+    max_duration: float = 0.1
+    pre_trigger: float = 2e-3
+    post_trigger: float = 2e-3
+    rebound_window: float = 0.1
+    hum_frequency: float | None = None
+    hum_q: float = 10.0
+    hum_harmonics: tuple = (1,)
+    lowpass_cutoff: float | None = None
+    lowpass_order: int = 4
+    clip_low: float | None = None
+    clip_high: float | None = None
+
+    def __post_init__(self):
+        def number(name, low=None, high=None, low_open=True, high_open=True, optional=False):
+            check_number(name, getattr(self, name), low=low, high=high, low_inclusive=not low_open,
+                         high_inclusive=not high_open, optional=optional)
+
+        for name in ("baseline_time_constant", "noise_time_constant", "warmup", "offset_hold", "min_duration",
+                     "max_duration", "k_on"):
+            number(name, 0)
+        number("k_off", 0, self.k_on)
+        for name in ("threshold_floor", "pre_trigger", "post_trigger", "rebound_window"):
+            number(name, 0, low_open=False)
+        number("rebound_window", 0, 60.0, low_open=False, high_open=False)
+        number("max_duration", self.min_duration, 60.0, high_open=False)
+        number("hum_frequency", 0, optional=True)
+        number("hum_q", 0.5)
+        number("lowpass_cutoff", 0, optional=True)
+        number("clip_low", optional=True)
+        number("clip_high", optional=True)
+        if self.clip_low is not None and self.clip_high is not None and not self.clip_low < self.clip_high:
+            raise ValueError(f"clip_high must be > clip_low = {self.clip_low}; got {self.clip_high!r}")
+        order = self.lowpass_order
+        if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 8:
+            raise ValueError(f"lowpass_order must be an integer in [1, 8]; got {order!r}")
+        harmonics = self.hum_harmonics
+        if (not isinstance(harmonics, (tuple, list)) or not 1 <= len(harmonics) <= 4
+                or any(isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= 16
+                       for k in harmonics)
+                or any(b <= a for a, b in itertools.pairwise(harmonics))):
+            raise ValueError(f"hum_harmonics must be 1 to 4 ascending integers in [1, 16]; got {harmonics!r}")
+        object.__setattr__(self, "hum_harmonics", tuple(int(k) for k in harmonics))
