@@ -1,0 +1,199 @@
+"""Sorting-line scorecard (issue 13, items 5 and 6): the analysis on recordings from an independent generator.
+
+One command:
+
+    python benchmarks/scorecard.py [--quick] [--markdown FILE] [--scenarios NAME,NAME]
+
+For each scenario of ``tests/linegen.py`` (chain feeding at 7 and 10 fruit/s/lane with ±8 % jitter, pads and
+plates with one or two rebounds whose flight is perturbed by ±10 %, close arrivals, hum + drift + 2–3 kHz plate
+ringing, 4 lanes of apples and pears at 25 kHz, pears from 3 cm) the recording is generated at benchmark size
+(≥ 80 contacts; ``--quick``: the tests' small sizes) in a temporary folder and analysed by the installed command
+line exactly as a user would run it::
+
+    fruitimpact analyze FILE --json --fit --drop-height H --hum 50|60 [--rate R --lanes K]
+
+then scored against the generator's truth (``linegen.score``).  One row per scenario: contacts, recall, extra
+reports, fruit taken for rebounds, rebounds taken for fruit, p95 |ΔF|/F (peak force), p95 |Δt_c|/t_c (time to
+peak), median and p95 |ΔK|/K (fitted stiffness, fruit only), p95 |Δe| (restitution, fruit only), overlap reports
+(and truth contacts that overlap another), analyze wall time; each goal of the issue marked ✓ or ✗ (recall 100 %,
+0 extra, 0 misflagged, F ≤ 1 %, t_c ≤ 2 %, K ≤ 2 % median and ≤ 5 % p95, e ≤ 0.03).  Then the grading lot
+(``grades``, analysed with ``--diameter --poisson --sort-by modulus --thresholds --classes``): its confusion
+matrix and the share of fruit ≥ 5 % from a threshold that get the right class (goal ≥ 98 %).
+
+The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+import linegen as lg  # noqa: E402  (tests/linegen.py: the independent generator)
+
+#: Columns: (header, key in the scorecard, format, goal key or None).
+COLUMNS = [
+    ("contacts", "contacts", "{:d}", None),
+    ("recall", "recall", "{:.1%}", "recall"),
+    ("extra", "extra", "{:d}", "extra"),
+    ("fruit→reb", "fruit_taken_for_rebounds", "{:d}", "fruit_taken_for_rebounds"),
+    ("reb→fruit", "rebounds_taken_for_fruit", "{:d}", "rebounds_taken_for_fruit"),
+    ("p95 ΔF/F", "peak_force_p95", "{:.2%}", "peak_force_p95"),
+    ("p95 Δtc/tc", "time_to_peak_p95", "{:.2%}", "time_to_peak_p95"),
+    ("med ΔK/K", "stiffness_median", "{:.2%}", "stiffness_median"),
+    ("p95 ΔK/K", "stiffness_p95", "{:.1%}", "stiffness_p95"),
+    ("p95 Δe", "restitution_p95", "{:.3f}", "restitution_p95"),
+    ("overlaps", "overlaps", "{}", None),
+    ("time", "time", "{:.1f} s", None),
+]
+
+
+def console_script() -> str:
+    beside = Path(sys.executable).with_name("fruitimpact")
+    found = str(beside) if beside.exists() else shutil.which("fruitimpact")
+    if not found:
+        sys.exit("console script 'fruitimpact' not found (pip install -e .)")
+    return found
+
+
+def run_scenario(scenario: lg.Scenario, size: int, folder: Path) -> dict:
+    """Generate, analyse by the CLI, score: the scorecard row (plus the grading for a grading lot)."""
+    t0 = time.perf_counter()
+    path, truth = lg.write(scenario, folder, size)
+    generated = time.perf_counter() - t0
+    argv = [console_script(), "analyze", str(path), *lg.analyze_options(truth)]
+    t0 = time.perf_counter()
+    proc = subprocess.run(argv, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise SystemExit(f"{scenario.name}: {' '.join(argv)} failed ({proc.returncode}):\n{proc.stderr}")
+    reports = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
+    card = lg.score(reports, truth)
+    command = " ".join(["fruitimpact", "analyze", path.name, *argv[3:]])
+    card.update(name=scenario.name, time=wall, generated=generated, command=command, goals=lg.check(card))
+    if scenario.grading:
+        card["grading"] = lg.grade(reports, truth)
+    return card
+
+
+def _cell(card: dict, key: str, fmt: str, goal: str | None, marks: bool) -> str:
+    value = card[key]
+    if key == "overlaps":
+        text = f"{value}/{card['truth_overlaps']}"
+    elif isinstance(value, float) and math.isinf(value):
+        text = "inf"
+    elif isinstance(value, float) and math.isnan(value):
+        text = "nan"
+    else:
+        text = fmt.format(value)
+    if marks and goal is not None:
+        text += " ✓" if card["goals"][goal] else " ✗"
+    return text
+
+
+def table(cards: list[dict], markdown: bool = False) -> str:
+    headers = ["scenario"] + [c[0] for c in COLUMNS]
+    rows = [[card["name"]] + [_cell(card, key, fmt, goal, True) for _, key, fmt, goal in COLUMNS] for card in cards]
+    signs = {">=": "≥ ", "<=": "≤ "}
+    goals = ["goal"] + ["" if goal is None else signs[lg.GOALS[goal][0]] + _goal_text(goal)
+                        for _, _, _, goal in COLUMNS]
+    rows.append(goals)
+    if markdown:
+        lines = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
+        lines += ["| " + " | ".join(r) + " |" for r in rows]
+        return "\n".join(lines)
+    widths = [max(len(r[i]) for r in rows + [headers]) for i in range(len(headers))]
+
+    def line(r):
+        return "  ".join(v.rjust(w) if i else v.ljust(w) for i, (v, w) in enumerate(zip(r, widths)))
+
+    return "\n".join([line(headers), line(["-" * w for w in widths])] + [line(r) for r in rows])
+
+
+def _goal_text(goal: str) -> str:
+    limit = lg.GOALS[goal][1]
+    if goal == "recall":
+        return "100%"
+    if goal == "restitution_p95":
+        return f"{limit:g}"
+    if isinstance(limit, int):
+        return str(limit)
+    return f"{limit:.0%}"
+
+
+def confusion_text(g: dict, markdown: bool = False) -> str:
+    classes = list(g["confusion"])
+    columns = classes + ["none"]
+    headers = ["true \\ reported"] + columns
+    rows = [[a] + [str(g["confusion"][a][b]) for b in columns] for a in classes]
+    if markdown:
+        lines = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
+        lines += ["| " + " | ".join(r) + " |" for r in rows]
+        body = "\n".join(lines)
+    else:
+        widths = [max(len(r[i]) for r in rows + [headers]) for i in range(len(headers))]
+        body = "\n".join("  ".join(v.rjust(w) for v, w in zip(r, widths)) for r in [headers] + rows)
+    ok = g["clear_accuracy"] >= lg.GRADING_GOAL
+    summary = (f"fruit {g['fruit']}; clear (true E ≥ 5 % from a threshold, first contact overlapping nothing) "
+               f"{g['clear']}: right {g['clear_right']} = {g['clear_accuracy']:.1%} "
+               f"(goal ≥ {lg.GRADING_GOAL:.0%}) {'✓' if ok else '✗'}; ungraded {g['ungraded']}; "
+               f"overlapped first contacts {g['overlapped']}")
+    return body + ("\n\n" if markdown else "\n") + summary
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="the tests' small sizes (~20-40 contacts)")
+    parser.add_argument("--markdown", metavar="FILE", help="also write the scorecard as Markdown")
+    parser.add_argument("--scenarios", metavar="NAMES", help="comma-separated scenarios (default: all)")
+    args = parser.parse_args(argv)
+    names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
+    unknown = [n for n in names if n not in lg.SCENARIOS]
+    if unknown:
+        parser.error(f"unknown scenarios {unknown}; known: {', '.join(lg.SCENARIOS)}")
+    cards = []
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
+        for name in names:
+            scenario = lg.SCENARIOS[name]
+            size = scenario.quick_size if args.quick else scenario.size
+            card = run_scenario(scenario, size, Path(folder))
+            cards.append(card)
+            print(f"  {name}: {card['contacts']} contacts, generated in {card['generated']:.1f} s, "
+                  f"analysed in {card['time']:.1f} s", file=sys.stderr, flush=True)
+    total = time.perf_counter() - t0
+    machine = platform.processor() or platform.machine()
+    head = (f"Sorting-line scorecard ({'quick' if args.quick else 'full'}), {machine}, "
+            f"Python {platform.python_version()}, total {total:.0f} s")
+    print(head)
+    print()
+    print(table(cards))
+    graded = [c for c in cards if "grading" in c]
+    for c in graded:
+        print()
+        print(f"Grading ({c['name']}, {c['contacts']} contacts):")
+        print(confusion_text(c["grading"]))
+    passed = sum(all(c["goals"].values()) for c in cards)
+    print()
+    print(f"{passed} of {len(cards)} scenarios meet every goal.")
+    if args.markdown:
+        text = [f"{head}", "", table(cards, markdown=True), ""]
+        for c in graded:
+            text += [f"Grading ({c['name']}, {c['contacts']} contacts):", "", confusion_text(c["grading"], True), ""]
+        text += ["Commands:", ""] + [f"    {c['command']}" for c in cards] + [""]
+        Path(args.markdown).write_text("\n".join(text))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

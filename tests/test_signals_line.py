@@ -1,0 +1,324 @@
+"""Sorting lines the project's own ``synth`` does not make (issue 13, items 5 and 6).
+
+The recordings come from ``tests/linegen.py``, an independent generator (its own Hunt–Crossley integration with
+SciPy, its own feed, rebound and sensor models; it imports nothing from fruitimpact).  Each scenario is written
+to a file and analysed by the command line as a user would (``fruitimpact analyze FILE --json --fit
+--drop-height H --hum F …``), then scored against the generator's truth with ``linegen.score``.
+
+The first group of tests checks the generator itself against physics it does not use to compute (the Hertz
+closed forms, the Hunt–Crossley first integral, the impulse–momentum theorem, the ballistic flight), and the
+scorer against hand-made reports, so that a failing scenario test points at the analysis, not at the truth.
+
+The goals are the issue's, for every scenario, with the reasons for each tolerance:
+
+* recall 100 % and 0 extra: every contact is a pulse of tens of newtons (second rebounds ≥ ~20 N) against a
+  noise σ of ~1 N, 20–130 σ: a detector at 6 σ must find all of them and invent none.  Contacts that overlap (a rebound
+  landing on the next fruit) count as found when an "overlap" report covers them (item 2).
+* 0 fruit taken for rebounds and 0 rebounds taken for fruit: a rebound is the same fruit after a flight of
+  2 e V / g (±10 % for spin and off-axis bounce) at e V less a few %: that is decidable from the previous
+  impact's own fit; a fruit fed by the chain is not (item 1).
+* peak force within 1 % (p95): at 1 % noise and 20 kHz the peak of a ~2 ms rising pulse is estimated to a few
+  tenths of a percent; the 2–3 kHz plate resonance with DC gain 1 changes F_max by (ω_pulse/ω_n)² ≈ 0.2 %.
+* time to peak within 2 % (p95): the onset extrapolated from the Hertz rising edge (F ∝ t^1.5) and the peak of
+  a smooth maximum give t_c to ~0.6 % sd at this noise: 2 % is ~3 sd.
+* fitted stiffness within 2 % (median) and 5 % (p95): the Cramér–Rao limit of k_c for one pulse at 1 % noise
+  is ~1.1 %; 5 % is the tail with hum residuals and ringing on top.
+* restitution within 0.03 (p95): e follows from the impulse m (1 + e) V with V known from the drop height;
+  0.03 covers the tail of the fit's e at this noise (its sd is ~0.005).
+
+Many scenario tests fail before issue 13's rebound logic lands: the detector takes a fruit fed at 7–10/s for the
+rebound of the one before (the default rebound window is 2V/g + 10 ms ≈ 0.21 s at 5 cm), and fits it at e V.
+That is the bug the issue is about; the goals are not relaxed for it.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import math
+from pathlib import Path
+
+import linegen as lg
+import numpy as np
+import pytest
+from conftest import G
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from fruitimpact.signals.read import read_recording
+
+#: Why each goal has its tolerance (printed with a failure).
+REASONS = {
+    "recall": "every contact is 20-130 noise sd high: all must be found (overlaps count when an overlap report "
+              "covers them)",
+    "extra": "no pulse is invented at 6 sd",
+    "fruit_taken_for_rebounds": "a fruit is a rebound only at the flight 2eV/g (±10 %) with the same fruit's pulse",
+    "rebounds_taken_for_fruit": "a rebound arrives after its parent's predicted flight, at e V",
+    "peak_force_p95": "1 % noise, 20 kHz, DC-gain-1 resonance: F_max to a few 0.1 %",
+    "time_to_peak_p95": "Hertz-edge onset and smooth peak: t_c sd ~0.6 %",
+    "stiffness_median": "Cramér–Rao limit of k_c at 1 % noise ~1.1 %",
+    "stiffness_p95": "tail of the k_c fit with hum residual and ringing",
+    "restitution_p95": "e from the impulse m(1+e)V with V known: sd ~0.005",
+}
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The generator against independent physics
+# ---------------------------------------------------------------------------------------------------------------
+
+def test_generator_imports_nothing_from_fruitimpact():
+    """Independence: linegen.py must not import the package it tests."""
+    tree = ast.parse(Path(lg.__file__).read_text())
+    names = [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+    names += [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert not [n for n in names if n.split(".")[0] == "fruitimpact"], names
+
+
+@pytest.mark.parametrize("damping", [0.0, 1e-7])
+def test_undamped_limit_is_the_hertz_impact(damping):
+    """c → 0: e → 1 and the classic Hertz impact (Johnson, Contact Mechanics §11.4): δ_m = (5 m V²/(4K))^0.4,
+    F_max = K δ_m^1.5, time to peak = 1.4716 δ_m / V (= δ_m/V ∫₀¹ dx/√(1 − x^2.5)), contact twice that."""
+    K, m, V = 1.0e6, 0.2, 1.0
+    p = lg.contact(K, m, damping, V)
+    dm = (5.0 * m * V ** 2 / (4.0 * K)) ** 0.4
+    integral = quad(lambda x: 1.0 / math.sqrt(1.0 - x ** 2.5), 0.0, 1.0, limit=200)[0]
+    assert p.restitution == pytest.approx(1.0, abs=1e-6)
+    assert p.max_deflection == pytest.approx(dm, rel=1e-7)
+    assert p.peak_force == pytest.approx(K * dm ** 1.5, rel=1e-7)
+    assert p.time_to_peak == pytest.approx(integral * dm / V, rel=1e-7)
+    assert p.time_to_peak == pytest.approx(1.4715 * dm / V, rel=1e-4)
+    assert p.duration == pytest.approx(2.0 * p.time_to_peak, rel=1e-7)
+
+
+@pytest.mark.parametrize("cv", [0.3, 0.7, 1.1, 1.7])
+def test_restitution_and_deflection_follow_the_hunt_crossley_first_integral(cv):
+    """m v dv/dδ = −K δ^1.5 (1 + c v) integrates once (Hunt & Crossley 1975) to
+    c V − ln(1 + c V) = −c V_out − ln(1 − c V_out) (separation, δ = 0) and
+    δ_m^2.5 = 2.5 m/(K c²) (c V − ln(1 + c V)) (maximum compression): independent of the integrator."""
+    K, m, V = 9.0e5, 0.18, 0.99
+    c = cv / V
+    p = lg.contact(K, m, c, V)
+    lhs = cv - math.log1p(cv)
+    b = brentq(lambda b: -b - math.log1p(-b) - lhs, 1e-12, 1.0 - 1e-15, xtol=1e-15)
+    assert p.restitution == pytest.approx(b / cv, rel=1e-7)
+    assert p.max_deflection == pytest.approx((2.5 * m / (K * c ** 2) * lhs) ** 0.4, rel=1e-7)
+    # the same fruit (same c) rebounding at the lower speed e V has a higher restitution
+    assert lg.contact(K, m, c, p.exit_velocity).restitution > p.restitution
+
+
+def test_impulse_of_the_tabulated_force_is_m_one_plus_e_v():
+    """Impulse–momentum: ∫F dt over the contact = m (V + V_out) = m (1 + e) V, for the force table the
+    recordings are built from (checks the table, not only the integrator's end state)."""
+    K, m, c, V = 1.1e6, 0.21, 1.1, 0.99
+    p = lg.contact(K, m, c, V)
+    assert np.trapezoid(p.table_f, p.table_t) == pytest.approx(m * (1.0 + p.restitution) * V, rel=1e-6)
+    assert 0.45 < p.restitution < 0.70
+    assert p.peak_force == pytest.approx(p.table_f.max(), rel=1e-9)
+
+
+def test_fruit_stiffness_is_the_hertz_sphere_on_a_plate():
+    """K = (4/3) E/(1 − ν²) √(d/2) [N/m^1.5]; G is standard gravity as in conftest."""
+    assert lg.stiffness(3e6, 0.35, 0.08) == pytest.approx(4 / 3 * 3e6 / (1 - 0.35 ** 2) * math.sqrt(0.04))
+    assert lg.G == G
+
+
+def test_rebounds_follow_the_flight_of_their_parent():
+    """A rebound leaves at its parent's exit speed V_up and flies 2 V_up/g (ballistic) perturbed by ±10 %; it
+    lands at V_up less 0–4 % (spin), on another spot (K ±5 %), same mass and damping; pads stop rebounds."""
+    _, truth = lg.generate("chain10", 12)
+    contacts = truth["contacts"]
+    rebounds = [c for c in contacts if c["is_rebound"]]
+    assert len(rebounds) >= 12 and any(c["rebound_of"] is not None and contacts[c["rebound_of"]]["is_rebound"]
+                                       for c in rebounds)  # second rebounds exist
+    factors = []
+    for c in rebounds:
+        parent = contacts[c["rebound_of"]]
+        fruit = truth["fruit"][c["fruit_id"]]
+        assert parent["fruit_id"] == c["fruit_id"] and parent["end_time"] < c["start_time"]
+        v_up = parent["exit_velocity"]
+        flight = c["start_time"] - parent["end_time"]
+        assert flight == pytest.approx(c["flight_time"], abs=1e-12)
+        factors.append(flight / (2.0 * v_up / G))
+        assert 0.96 - 1e-12 <= c["velocity"] / v_up <= 1.0
+        assert abs(c["stiffness"] / fruit["stiffness"] - 1.0) <= 0.05 + 1e-12
+        assert c["mass"] == fruit["mass"] and c["damping"] == fruit["damping"]
+        assert c["restitution"] > contacts[c["rebound_of"]]["restitution"] - 0.02  # slower: more elastic
+    assert 0.9 - 1e-12 <= min(factors) < 0.95 and 1.05 < max(factors) <= 1.1 + 1e-12
+    _, pad = lg.generate("pad", 10)
+    assert not any(c["is_rebound"] for c in pad["contacts"])
+
+
+def test_chain_feed_pitch_jitter_and_close_arrivals():
+    """Chain: consecutive slots are P (1 ± 2 × 8 %) apart; close arrivals land 2–20 ms after the previous
+    fruit's contact ended; the recording starts with ≥ 0.1 s of quiet signal."""
+    _, truth = lg.generate("close", 40)
+    sc = lg.SCENARIOS["close"]
+    pitch = 1.0 / sc.fruit_rate
+    first = [c for c in truth["contacts"] if not c["is_rebound"]]
+    assert first[0]["start_time"] >= 0.1
+    closes = 0
+    for a, b in zip(first, first[1:]):
+        if b["close_arrival"]:
+            closes += 1
+            assert 0.002 <= b["start_time"] - a["end_time"] <= 0.020
+        elif not a["close_arrival"]:
+            assert 0.84 * pitch - 1e-12 <= b["start_time"] - a["start_time"] <= 1.16 * pitch + 1e-12
+    assert closes == 2  # 5 % of 40
+
+
+def test_overlaps_in_the_truth_are_symmetric_and_real():
+    """A contact listed as overlapping another shares time with it on the same lane."""
+    _, truth = lg.generate("chain10", 15)
+    contacts = truth["contacts"]
+    listed = 0
+    for c in contacts:
+        for j in c["overlaps"]:
+            d = contacts[j]
+            listed += 1
+            assert c["index"] in d["overlaps"] and d["lane"] == c["lane"]
+            assert c["start_time"] < d["end_time"] and d["start_time"] < c["end_time"]
+    assert listed > 0
+
+
+def test_resonance_discretisation_keeps_dc_gain_and_the_resonance():
+    """Bilinear transform prewarped at ω_n: H(z = 1) = 1 (DC gain 1: impulses kept) and |H(e^{jω_n T})| =
+    |H(jω_n)| = 1/(2ζ) exactly."""
+    b, a = lg.resonance_coefficients(2500.0, 0.05, 160_000.0)
+    assert b.sum() / a.sum() == pytest.approx(1.0, rel=1e-12)
+    z = np.exp(1j * 2 * math.pi * 2500.0 / 160_000.0)
+    h = np.polyval(b[::-1], 1 / z) / np.polyval(a[::-1], 1 / z)
+    assert abs(h) == pytest.approx(1.0 / (2 * 0.05), rel=1e-9)
+
+
+def test_sensor_chain_keeps_each_lanes_impulse_and_peaks():
+    """Without offset, drift, hum and noise, each lane's samples sum (× 1/rate) to the sum of its contacts'
+    impulses m (1 + e) V (the resonance has DC gain 1), and an isolated contact's sampled maximum is its true
+    peak within 1 % (the resonance's quasi-static error ~0.2 %, sampling ≤ 0.1 %)."""
+    recording, truth = lg.generate("lanes4", 3, clean=True)
+    rate = truth["rate"]
+    for lane in range(4):
+        impulses = sum(c["impulse"] for c in truth["contacts"] if c["lane"] == lane)
+        assert recording[:, lane].astype(float).sum() / rate == pytest.approx(impulses, rel=2e-4)
+    for c in truth["contacts"]:
+        if c["overlaps"]:
+            continue
+        i0, i1 = int(c["start_time"] * rate), int(c["end_time"] * rate) + 2
+        assert recording[i0:i1, c["lane"]].max() == pytest.approx(c["peak_force"], rel=0.01)
+
+
+def test_noise_and_hum_levels():
+    """White noise σ = 1 % and hum 1.5 % of the median primary peak (noisy): on the quiet start, a least-squares
+    fit of offset, slope and the hum's 1st and 3rd harmonics leaves the noise σ within 10 %, and finds the hum."""
+    recording, truth = lg.generate("noisy", 4)
+    s = truth["sensor"]
+    n = int(0.1 * truth["rate"])
+    t = np.arange(n) / truth["rate"]
+    w = 2 * math.pi * s["hum_frequency"]
+    basis = np.column_stack([np.ones(n), t, np.sin(w * t), np.cos(w * t), np.sin(3 * w * t), np.cos(3 * w * t)])
+    coef, *_ = np.linalg.lstsq(basis, recording[:n, 0].astype(float), rcond=None)
+    residual = recording[:n, 0] - basis @ coef
+    assert np.std(residual) == pytest.approx(s["noise_sd"], rel=0.1)
+    assert math.hypot(coef[2], coef[3]) == pytest.approx(s["hum_amplitude"], rel=0.1)
+    assert s["noise_sd"] == pytest.approx(0.01 * s["typical_peak"])
+
+
+@pytest.mark.parametrize("fmt", ["csv", "f32", "tdms", "npy"])
+def test_files_read_back_with_the_truths_lane_names(tmp_path, fmt):
+    """The writers produce what the reader expects: the lane names it reports are the truth's (reports carry
+    them in ``lane``), the rate and the samples are the generator's."""
+    recording, truth = lg.generate("lanes4", 2)
+    path = tmp_path / f"x{lg.EXTENSION[fmt]}"
+    lg.write_recording(path, recording, truth["rate"], fmt)
+    rec = read_recording(path, rate=None if fmt in ("csv", "tdms") else truth["rate"], lanes=4 if fmt == "f32" else 1)
+    assert list(rec.lanes) == lg.lane_names(fmt, 4)
+    assert rec.rate == pytest.approx(truth["rate"], rel=1e-9)
+    for i, name in enumerate(rec.lanes):
+        np.testing.assert_allclose(rec.lanes[name], recording[:, i], rtol=1e-7, atol=1e-6)
+
+
+def _perfect_reports(truth):
+    return [dict(lane=c["lane_name"], start_time=c["start_time"] + 2e-4, peak_force=c["peak_force"],
+                 time_to_peak=c["time_to_peak"], contact_duration=c["contact_duration"], rebound=c["is_rebound"],
+                 stiffness=c["stiffness"], restitution=c["restitution"], sequence=c["index"],
+                 rebound_of=c["rebound_of"], extra_key="ignored", **{"class": c["class"]})
+            for c in truth["contacts"]]
+
+
+def test_score_of_a_perfect_and_of_a_spoilt_analysis():
+    """The scorer: the truth as reports scores perfectly; each kind of mistake is counted where it belongs."""
+    _, truth = lg.generate("chain10", 8)
+    reports = _perfect_reports(truth)
+    card = lg.score(reports, truth)
+    assert all(lg.check(card).values()) and card["wrong_parent"] == 0, card
+    contacts = truth["contacts"]
+    primary = next(i for i, c in enumerate(contacts) if not c["is_rebound"] and not c["overlaps"])
+    rebound = next(i for i, c in enumerate(contacts) if c["is_rebound"] and not c["overlaps"])
+    spoilt = [dict(r) for r in reports]
+    spoilt[primary].update(rebound=True, stiffness=2 * contacts[primary]["stiffness"])
+    spoilt[rebound]["rebound"] = False
+    del spoilt[-1]                                                       # one missed
+    spoilt.append(dict(spoilt[0], start_time=spoilt[0]["start_time"] + 0.05))  # one invented
+    card = lg.score(spoilt, truth)
+    assert card["recall"] == pytest.approx((len(contacts) - 1) / len(contacts))
+    assert card["extra"] == 1 and card["missed"] == 1
+    assert card["fruit_taken_for_rebounds"] == 1 and card["rebounds_taken_for_fruit"] == 1
+    assert card["stiffness_p95"] > 0.5 and card["stiffness_median"] == 0.0
+    # an overlap report covering two contacts: both found, neither in the error statistics
+    a, b = next((c, contacts[j]) for c in contacts for j in c["overlaps"] if j > c["index"])
+    merged = [r for r in reports if r["sequence"] not in (a["index"], b["index"])]
+    merged.append(dict(lane=a["lane_name"], start_time=a["start_time"], status="overlap", rebound=False,
+                       peak_force=3 * a["peak_force"], time_to_peak=1.0,
+                       contact_duration=b["end_time"] - a["start_time"]))
+    card = lg.score(merged, truth)
+    assert card["recall"] == 1.0 and card["extra"] == 0 and card["overlaps"] == 1
+    assert card["peak_force_p95"] == 0.0 and card["time_to_peak_p95"] == 0.0
+
+
+def test_grade_counts_classes_of_the_clear_fruit():
+    """Grading: the class of each fruit's first contact; right/total over fruit ≥ 5 % from a threshold whose
+    first contact overlaps nothing; the confusion matrix over every fruit."""
+    _, truth = lg.generate("grades", 30)
+    reports = _perfect_reports(truth)
+    g = lg.grade(reports, truth)
+    assert g["clear_accuracy"] == 1.0 and g["ungraded"] == 0
+    assert sum(sum(row.values()) for row in g["confusion"].values()) == 30
+    fruit = next(f for f in truth["fruit"] if not truth["contacts"][f["contacts"][0]]["overlaps"]
+                 and all(abs(f["modulus"] / t - 1) >= 0.05 for t in truth["thresholds"]))
+    wrong = next(k for k in truth["classes"] if k != fruit["class"])
+    reports[fruit["contacts"][0]]["class"] = wrong
+    assert lg.grade(reports, truth)["clear_right"] == g["clear_right"] - 1
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The analysis on the line scenarios
+# ---------------------------------------------------------------------------------------------------------------
+
+def _analyse(cli, tmp_path, name):
+    scenario = lg.SCENARIOS[name]
+    path, truth = lg.write(scenario, tmp_path, scenario.quick_size)
+    status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))
+    assert status == 0, err
+    return [json.loads(line) for line in out.splitlines()], truth
+
+
+@pytest.mark.parametrize("name", [name for name in lg.SCENARIOS if not lg.SCENARIOS[name].grading])
+def test_line_scenario_meets_the_issue_goals(cli, tmp_path, name):
+    """Every goal of issue 13 item 6 on one scenario (≥ 20 contacts); the message lists every goal missed, the
+    physics behind its tolerance, and the whole scorecard."""
+    reports, truth = _analyse(cli, tmp_path, name)
+    card = lg.score(reports, truth)
+    assert card["contacts"] >= 20
+    missed = [f"{key} = {card[key]:.4g} (goal {op} {limit}: {REASONS[key]})"
+              for key, (op, limit) in lg.GOALS.items() if not lg.check(card)[key]]
+    assert not missed, f"{name}: " + "; ".join(missed) + f"\nscorecard: {card}"
+
+
+def test_line_grading_meets_the_issue_goal(cli, tmp_path):
+    """Item 5: a lot with a known lognormal modulus population, rebounds (1–2), 5 % close arrivals, hum, drift
+    and 2.5 kHz ringing, analysed with one nominal diameter (lot spread 3 %: E ∝ d^−1/2 → 1.5 % sd) and ν:
+    ≥ 98 % of the fruit whose true modulus lies ≥ 5 % from a threshold get the right class.  5 % is ~3 sd of
+    the modulus estimate (fit ~1 % and diameter 1.5 %), so a right rebound decision leaves ~0.1 % wrong."""
+    reports, truth = _analyse(cli, tmp_path, "grades")
+    g = lg.grade(reports, truth)
+    assert g["clear"] >= 30
+    assert g["clear_accuracy"] >= lg.GRADING_GOAL, (g["clear_right"], g["clear"], g["confusion"], g["wrong"])
