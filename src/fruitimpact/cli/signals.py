@@ -35,8 +35,12 @@ def add_analysis_options(parser) -> None:
     det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic")
     det.add_argument("--lowpass", metavar="HZ", help="causal Butterworth low-pass (order 4) at this frequency")
     det.add_argument("--rebound-window", metavar="S",
-                     help="an impact within this time after the previous one, and smaller, is its rebound (default: "
-                          "the longest flight 2 V/g + 10 ms when the velocity or drop height is given, else 0.1 s)")
+                     help="longest rebound flight considered; 0: no rebound detection (default 1.25 x 2V/g + 10 ms "
+                          "with the velocity or drop height, else 0.3 s). A contact is a rebound only when its flight, "
+                          "speed, peak, time to peak and shape are those of the same fruit")
+    det.add_argument("--pitch", metavar="S", help="the feed's time between fruit of a lane, when known (a prior "
+                                                   "for the rebound decision)")
+    det.add_argument("--fruit-rate", metavar="HZ", help="fruit per second per lane, instead of --pitch")
     det.add_argument("--k-on", default="6", metavar="K", help="onset threshold in noise σ (default 6)")
     det.add_argument("--k-off", default="3", metavar="K", help="offset threshold in noise σ (default 3)")
     det.add_argument("--clip", metavar="LOW,HIGH", help="the acquisition's limits [N]: impacts reaching them are flagged")
@@ -78,11 +82,14 @@ def analysis_from(args, rate: float):
     if height is not None:
         velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
     window = _float("--rebound-window", args.rebound_window, "time", low_inclusive=True, high=10.0)
-    if window is None:  # a rebound flies at most 2 V/g (e <= 1)
-        window = 2.0 * velocity / STANDARD_GRAVITY + 0.01 if velocity is not None else 0.1
+    pitch = _float("--pitch", args.pitch, "time", low=1e-3, low_inclusive=True, high=60.0)
+    fruit_rate = _float("--fruit-rate", args.fruit_rate, "frequency", high=1000.0)
+    if pitch is not None and fruit_rate is not None:
+        raise UsageError("give either --pitch or --fruit-rate, not both")
+    if fruit_rate is not None:
+        pitch = 1.0 / fruit_rate
     try:
         settings = DetectorSettings(
-            rebound_window=window,
             k_on=_float("--k-on", args.k_on, "dimensionless"), k_off=_float("--k-off", args.k_off, "dimensionless"),
             hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
             clip_low=clip[0], clip_high=clip[1])
@@ -107,20 +114,68 @@ def analysis_from(args, rate: float):
         except ValueError as exc:
             raise UsageError(f"argument --sort-by/--thresholds: {exc}") from None
     try:
-        analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity if args.fit or velocity else None,
-                            mass=mass, diameter=diameter, poisson=poisson, classes=classes)
+        analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,
+                            poisson=poisson, classes=classes, max_flight=window, pitch=pitch)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     return settings, analysis
 
 
 # ------------------------------------------------------------------------------------------- analyze
-def cmd_analyze(args) -> int:
-    import numpy as np
+#: Samples per lane read and analysed at once by ``analyze`` (memory is bounded by this, not the file).
+ANALYZE_CHUNK = 1 << 18
 
+
+def _table_header(analysis) -> str:
+    header = f"{'lane':<10}{'t [s]':>10}{'F_max [N]':>11}{'t_c [ms]':>10}{'T [ms]':>9}{'C [N/ms]':>10}" \
+             f"{'C* [N/ms²]':>12}{'impulse':>10}  status/flags"
+    if analysis.fit:
+        header += "   k_c, e, m|V"
+    return header
+
+
+def _table_row(r: dict, analysis) -> str:
+    flags = [r["status"]] if r.get("status") != "ok" else []
+    if r.get("rebound"):
+        flags.append(f"rebound of #{r['rebound_of']}")
+    if r.get("rebound_ambiguous"):
+        flags.append("ambiguous")
+    line = (f"{r['lane']:<10}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"
+            f"{r['contact_duration'] * 1e3:>9.4g}{r['firmness_c'] / 1e3:>10.4g}"
+            f"{r['firmness_c_star'] / 1e6:>12.4g}{r['impulse']:>10.4g}  {','.join(flags) or '-'}")
+    if analysis.fit:
+        other = "mass" if analysis.mass is None else "velocity"
+        line += f"   {r.get('stiffness', math.nan):.4g}, {r.get('restitution', math.nan):.3g}, " \
+                f"{r.get(other, math.nan):.4g}"
+    if r.get("class"):
+        line += f"   {r['class']}"
+    return line
+
+
+class _Progress:
+    """``--progress``: one self-overwriting line on stderr, at most every half second."""
+
+    def __init__(self, total: int | None, rate: float):
+        import time
+
+        self.clock = time.monotonic
+        self.total, self.rate, self.start, self.shown = total, rate, self.clock(), 0.0
+
+    def update(self, done: int, impacts: int, final: bool = False) -> None:
+        now = self.clock()
+        if not final and now - self.shown < 0.5:
+            return
+        self.shown = now
+        elapsed = max(now - self.start, 1e-9)
+        share = f"{100.0 * done / self.total:5.1f} % " if self.total else ""
+        print(f"\r{PROG} analyze: {share}{done / self.rate:.1f} s of signal, {impacts} impacts, "
+              f"{done / self.rate / elapsed:.0f}x real time", end="\n" if final else "", file=sys.stderr, flush=True)
+
+
+def cmd_analyze(args) -> int:
     from ..signals.analysis import public
-    from ..signals.detect import Detector
-    from ..signals.read import read_recording
+    from ..signals.read import open_recording
+    from ..signals.stream import StreamAnalyzer
 
     rate = _float("--rate", args.rate, "frequency")
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
@@ -135,53 +190,59 @@ def cmd_analyze(args) -> int:
             raise UsageError(str(exc)) from None
     analysis_from(args, rate if rate is not None else 1e12)  # every option checked before the file is read
     try:
-        recording = read_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
+        source = open_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
     except ValueError as exc:
-        text = str(exc)
-        option = "--rate" if "rate" in text and ("required" in text or "disagree" in text) else \
-            "--column" if "column" in text and args.column else "FILE"
-        raise UsageError(f"argument {option}: {text.replace('give rate= [Hz]', 'give --rate HZ')}") from None
-    settings, analysis = analysis_from(args, recording.rate)
-    detector = _library_call(Detector, recording.rate, settings, lanes=len(recording.lanes))
-    matrix = np.column_stack([recording.lanes[name] for name in recording.lane_names])
-    impacts = detector.feed(matrix) + detector.flush()
-    impacts.sort(key=lambda impact: (impact.start_index, impact.lane))
-    reports = []
-    for impact in impacts:
-        report = analysis.report(impact)
-        report["lane"] = recording.lane_names[impact.lane]
-        report["start_time"] = report["start_time"] + recording.start_time
-        reports.append(report)
-        if args.json:
-            print(_json_line(public(report)), flush=False)
+        raise UsageError(_reading_error(exc, args)) from None
+    settings, analysis = analysis_from(args, source.rate)
+    keep = bool(args.plot)  # a figure of the recording needs its samples and windows
+    impacts, reports = [], []
+
+    def emit(impact, report):
+        if keep:
+            impacts.append(impact)
+            reports.append(report)
+        print(_json_line(public(report)) if args.json else _table_row(report, analysis), flush=False)
+
+    analyzer = _library_call(StreamAnalyzer, source.rate, len(source.lane_names), settings, lambda report: None,
+                             on_detected=emit, analysis=analysis, lane_names=source.lane_names,
+                             start_time=source.start_time)
     if not args.json:
-        print(f"{args.file}: {len(reports)} impacts in {recording.duration:.4g} s, {len(recording.lanes)} lane(s) at "
-              f"{recording.rate:g} Hz" + (" (fitted)" if analysis.fit else ""))
-        header = f"{'lane':<10}{'t [s]':>10}{'F_max [N]':>11}{'t_c [ms]':>10}{'T [ms]':>9}{'C [N/ms]':>10}" \
-                 f"{'C* [N/ms²]':>12}{'impulse':>10}  flags"
-        if analysis.fit:
-            header += "   k_c, e, m|V"
-        print(header)
-        for r in reports:
-            flags = ",".join(name for name in ("rebound", "clipped", "truncated") if r.get(name))
-            line = (f"{r['lane']:<10}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"
-                    f"{r['contact_duration'] * 1e3:>9.4g}{r['firmness_c'] / 1e3:>10.4g}"
-                    f"{r['firmness_c_star'] / 1e6:>12.4g}{r['impulse']:>10.4g}  {flags}")
-            if analysis.fit:
-                other = "mass" if analysis.velocity is not None else "velocity"
-                line += f"   {r.get('stiffness', math.nan):.4g}, {r.get('restitution', math.nan):.3g}, " \
-                        f"{r.get(other, math.nan):.4g}"
-            if "class" in r:
-                line += f"   {r['class']}"
-            print(line)
+        print(f"{args.file}: {len(source.lane_names)} lane(s) at {source.rate:g} Hz"
+              + (" (fitted)" if analysis.fit else ""))
+        print(_table_header(analysis))
+    progress = _Progress(source.samples, source.rate) if args.progress else None
+    done = 0
+    try:
+        for chunk in source.chunks(ANALYZE_CHUNK):
+            analyzer.feed(chunk)
+            done += chunk.shape[0]
+            if progress is not None:
+                progress.update(done, analyzer.impacts)
+    except ValueError as exc:  # a bad row found mid-file: what was analysed before it stands
+        sys.stdout.flush()
+        raise UsageError(_reading_error(exc, args)) from None
+    analyzer.close()
+    if progress is not None:
+        progress.update(done, analyzer.impacts, final=True)
+    if not args.json:
+        print(f"{analyzer.impacts} impacts in {done / source.rate:.4g} s")
     if args.plot:
         from ..plotting import save_figure
         from ..plotting.signals import analysis_figure
+        from ..signals.read import read_recording
 
+        recording = read_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
         _library_call(save_figure, analysis_figure(recording, impacts, reports, analysis), args.plot, "--plot")
         if not args.json:
             print(f"figure written to {args.plot}")
     return 0
+
+
+def _reading_error(exc: ValueError, args) -> str:
+    text = str(exc)
+    option = "--rate" if "rate" in text and ("required" in text or "disagree" in text) else \
+        "--column" if "column" in text and args.column else "FILE"
+    return f"argument {option}: {text.replace('give rate= [Hz]', 'give --rate HZ')}"
 
 
 # ------------------------------------------------------------------------------------------- classes
@@ -240,6 +301,7 @@ def add_parsers(sub) -> None:
     an.add_argument("--lanes", default="1", metavar="K", help="interleaved lanes of a raw float32 file (default 1)")
     add_analysis_options(an)
     an.add_argument("--json", action="store_true", help="one JSON object per line, one per impact (SI)")
+    an.add_argument("--progress", action="store_true", help="show progress on stderr (long recordings)")
     an.add_argument("--plot", metavar="FILE", help="the recording with its impacts (and fits) (PNG/SVG/PDF)")
     an.set_defaults(func=cmd_analyze)
 
@@ -399,11 +461,9 @@ def cmd_stream(args) -> int:
         port = int(args.listen)
     settings, analysis = analysis_from(args, rate)
 
-    def emit(impact, _values):
-        report = analysis.report(impact)
-        report["lane"] = f"lane{impact.lane}"
+    def emit(report):
         sys.stdout.write(_json_line(public(report)) + "\n")
-        sys.stdout.flush()  # one line per impact as soon as it is known
+        sys.stdout.flush()  # one line per contact as soon as it is known
 
     def problem(message):
         print(f"{PROG} stream: warning: {message}", file=sys.stderr, flush=True)
@@ -412,12 +472,12 @@ def cmd_stream(args) -> int:
         def listening(actual):
             print(f"{PROG} stream: listening on 127.0.0.1:{actual}", file=sys.stderr, flush=True)
 
-        _library_call(serve, port, rate, lanes, settings, lambda values: None, source=source, on_problem=problem,
-                      on_listening=listening, on_detected=emit)
+        _library_call(serve, port, rate, lanes, settings, emit, source=source, on_problem=problem,
+                      on_listening=listening, analysis=analysis)
         return 0
-    analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, lambda values: None, source=source,
-                             on_problem=problem, on_detected=emit)
-    summary = analyzer.run(iter_chunks(sys.stdin.buffer))
+    analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, emit, source=source, on_problem=problem,
+                             analysis=analysis)
+    summary = _library_call(analyzer.run, iter_chunks(sys.stdin.buffer))
     print(f"{PROG} stream: {summary['samples']} samples, {summary['impacts']} impacts"
           + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
           + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
@@ -428,12 +488,14 @@ def cmd_stream(args) -> int:
 def add_stream_parser(sub) -> None:
     st = sub.add_parser("stream", help="real time: samples in (stdin or TCP), one JSON line per impact out",
                         description="Read force samples continuously (stdin as text lines or raw float32, or a "
-                                    "TCP socket on localhost) and write one JSON line per impact as soon as it "
-                                    "has ended and its rebound window has closed: the same objects as analyze.")
+                                    "TCP socket on localhost) and write one JSON line per contact as soon as it "
+                                    "has ended (a later rebound is its own line with rebound_of): the same "
+                                    "objects as analyze --json.")
     st.add_argument("--rate", metavar="HZ", help="sample rate [Hz] (required)")
     st.add_argument("--lanes", default="1", metavar="K", help="numbers per sample (default 1)")
     st.add_argument("--format", default="text", metavar="FMT", help="text (one sample per line) or f32 (raw "
                                                                      "little-endian float32, lanes interleaved)")
     st.add_argument("--listen", metavar="PORT", help="serve a TCP socket on 127.0.0.1:PORT instead of stdin")
+    st.add_argument("--json", action="store_true", help="JSON lines (what stream always writes; as analyze --json)")
     add_analysis_options(st)
     st.set_defaults(func=cmd_stream)

@@ -1,31 +1,86 @@
-"""One impact's report: the raw indices, and with a fit the model's indices and parameters.
+"""One contact's report: its own samples, the raw indices, whether it is a new fruit or a rebound, and
+with a fit the model's indices and parameters; a fruit's firmness class.
 
-``Analysis`` holds what every impact of a recording or a stream is analysed with
-(the detector settings, the fit's knowns, the firmness classes), so that
-``fruitimpact analyze`` and ``fruitimpact stream`` produce the same JSON object for
-the same samples: both call ``Analysis.report``.
+``Analysis`` holds what every contact of a recording or a stream is analysed with (the detector's
+rate, the fit's knowns, the feed, the firmness classes); ``Analysis.analyzer()`` gives the state of one
+stream (``LineAnalyzer``: the recent contacts of each lane, for the rebound decisions), so that
+``fruitimpact analyze`` and ``fruitimpact stream`` produce the same JSON object for the same samples.
+
+For each contact, in order, as soon as the detector emits it (nothing waits for a later contact):
+
+1. **Its own samples.**  The window is cut after the previous contact of the lane ended and before the
+   next one began (``DetectedImpact.previous_end`` / ``next_start``, less the rise the next contact
+   had before it crossed the threshold): two fruit a few milliseconds apart are two contacts, each
+   measured on its own samples.
+2. **Raw indices** (``indices.impact_indices``).
+3. **Overlap.**  A contact whose force falls and rises again by more than ``OVERLAP_FRACTION`` of its
+   peak (``indices.second_pulse``) holds two fruit (or a fruit and a rebound): status ``overlap``, no
+   firmness, no fit, no class.
+4. **Rebound or new fruit** (``signals.rebounds``): decided from the contacts before it, by the
+   fruit's own physics (flight, speed ratio, peak, time to peak, shape), with the evidence when the
+   decision is near its boundary.
+5. **Fit** (optional): a new fruit at the line's velocity (or with the given mass), a rebound at its
+   own speed r V_p.
+6. **Class** (optional): for a new fruit only; a rebound is the same fruit, already graded, and its
+   line carries ``rebound_of``.
+
+Every report has ``status`` (``ok``, ``overlap``, ``truncated``, ``overlong``, ``clipped``, ``unfitted``
+when a requested fit did not converge) and ``message``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import STANDARD_GRAVITY
 from .detect import DetectedImpact
-from .indices import impact_indices
+from .indices import impact_indices, second_pulse
+from .rebounds import PulseSummary, from_indices, judge, refine
 from .sort import FirmnessClasses
 
 #: Keys of a fit that join the report (a contract: analyze --fit).
 FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
+#: Keys of every report beside the indices (a contract of analyze --json and stream).
+REPORT_KEYS = ("sequence", "status", "message", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence")
+#: A second rise (or an earlier fall) larger than this share of the peak is a second fruit in the contact.
+OVERLAP_FRACTION = 0.10
+#: A fit whose RMS residual exceeds this multiple of the noise σ is not one pulse: one Hunt–Crossley contact
+#: leaves the noise (0.97–1.33 σ measured over the line scenarios of tests/linegen.py, 2–3 kHz plate
+#: ringing with ζ 0.03–0.1 included); two fruit landing within a fraction of a time to peak leave 1.7–10 σ.
+RESIDUAL_LIMIT = 1.6
+#: Firmness indices withheld from an overlap (they would describe neither fruit).
+FIRMNESS_KEYS = ("firmness_c", "firmness_c_star")
+#: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
+DEFAULT_MAX_FLIGHT = 0.3
 
 
 @dataclass(frozen=True)
 class Analysis:
-    """How impacts are analysed: ``rate`` [Hz], whether to ``fit`` the simulator's force law, its knowns
-    ``velocity`` [m/s] or ``mass`` [kg] (one of them), ``diameter`` [m] and ``poisson`` for the modulus,
-    and optional firmness ``classes``."""
+    """How contacts are analysed.
+
+    Parameters
+    ----------
+    rate : float
+        Sample rate [Hz].
+    fit : bool
+        Fit the simulator's force law to every contact.
+    velocity, mass : float, optional
+        The fit's knowns (one of them with ``fit``): the line's impact velocity [m/s] (from the drop
+        height) or the fruit mass [kg].  The velocity also predicts rebound flights.
+    diameter, poisson : float, optional
+        Both or neither: the modulus follows from k_c.
+    classes : FirmnessClasses, optional
+        Firmness classes of each new fruit.
+    max_flight : float, optional
+        Longest rebound flight considered [s]; 0 disables rebound detection.  Default: 1.25 × 2V/g +
+        10 ms with a velocity (a fruit cannot come back faster than it came), else 0.3 s.
+    pitch : float, optional
+        The feed's time between fruit of a lane [s], when known: a prior for the rebound decision.
+    """
 
     rate: float
     fit: bool = False
@@ -34,8 +89,8 @@ class Analysis:
     diameter: float | None = None
     poisson: float | None = None
     classes: FirmnessClasses | None = None
-    #: the fitted impacts of each lane by sequence number (a rebound's velocity is e V of the impact it rebounds from)
-    _fitted: dict = field(default_factory=dict, repr=False, compare=False)
+    max_flight: float | None = None
+    pitch: float | None = None
 
     def __post_init__(self):
         if self.fit and (self.velocity is None) == (self.mass is None):
@@ -47,45 +102,150 @@ class Analysis:
             raise ValueError(f"classes by {self.classes.by} need --fit")
         if self.classes is not None and self.classes.by == "modulus" and self.diameter is None:
             raise ValueError("classes by modulus need --diameter and --poisson")
+        for name in ("max_flight", "pitch"):
+            value = getattr(self, name)
+            low = 0.0 if name == "max_flight" else 1e-3
+            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)
+                                          and low <= value <= 60.0):
+                raise ValueError(f"{name} must be a number of seconds in [{low:g}, 60]; got {value!r}")
+
+    @property
+    def flight_limit(self) -> float:
+        """The longest rebound flight considered [s] (``max_flight`` or its default)."""
+        if self.max_flight is not None:
+            return self.max_flight
+        if self.velocity is not None:
+            return 1.25 * 2.0 * self.velocity / STANDARD_GRAVITY + 0.01
+        return DEFAULT_MAX_FLIGHT
+
+    def analyzer(self) -> LineAnalyzer:
+        """A fresh analyser for one stream (its own lane histories)."""
+        return LineAnalyzer(self)
+
+
+class LineAnalyzer:
+    """The state of one stream's analysis: the recent contacts of each lane (``Analysis`` does the rest).
+    ``report(impact)`` must be called for the impacts of a lane in the order the detector emits them."""
+
+    def __init__(self, analysis: Analysis):
+        self.analysis = analysis
+        self._history: dict[int, list[PulseSummary]] = {}
+        self._last_fruit: dict[int, float] = {}
 
     def report(self, impact: DetectedImpact) -> dict:
-        """The dict of one impact (SI); ``public(report)`` is its JSON object."""
-        report = impact_indices(impact, self.rate)
-        report["rebound_of"] = impact.rebound_of
+        """The dict of one contact (SI); ``public(report)`` is its JSON object."""
+        analysis = self.analysis
+        own = isolated(impact)
+        report = impact_indices(own, analysis.rate)
         report["sequence"] = impact.sequence
-        if self.fit:
-            time = (impact.window_start + np.arange(impact.window.size)) / self.rate
-            velocity = self.velocity
-            if impact.rebound and velocity is not None:
-                # the fruit comes back at the rebound speed of the impact before: e V of its fit
-                before = self._fitted.get((impact.lane, impact.rebound_of))
-                velocity = before["restitution"] * before["velocity"] if before is not None and \
-                    _finite(before.get("restitution")) and _finite(before.get("velocity")) else None
-            result = _fit(time, impact, self, velocity) if velocity is not None or self.mass is not None else \
-                {"converged": False, "message": "a rebound whose first impact was not fitted: its velocity is unknown"}
-            self._fitted[(impact.lane, impact.sequence)] = result
-            for stale in [key for key in self._fitted if key[0] == impact.lane and key[1] < impact.sequence - 8]:
-                del self._fitted[stale]
-            for key in ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c",
-                        "firmness_c_star", "impulse"):
-                if key in result and result.get("converged") and _finite(result[key]):
-                    report[f"raw_{key}"] = report.get(key)
-                    report[key] = result[key]
-            for key in FIT_KEYS:
-                if key in result:
-                    report[key] = result[key]
-                    report[f"{key}_stderr"] = result.get(f"{key}_stderr", math.nan)
-            report["fit_residual"] = result.get("fit_residual", math.nan)
-            report["fit_residual_relative"] = result.get("fit_residual_relative", math.nan)
-            report["fit_converged"] = bool(result.get("converged", False))
-            report["fit_message"] = result.get("message", "")
-            report["_fit"] = result  # the whole fit (for figures); not part of the JSON
-        if self.classes is not None:
-            value = report.get(self.classes.by, math.nan)
-            label = self.classes.classify([value if _finite(value) else math.nan])[0]
-            report["class"] = label
-            report["class_by"] = self.classes.by
+        status, message = _status(impact)
+        peak = report["peak_force"]
+        second = second_pulse(own)
+        shape = None
+        if _finite(peak) and peak > 0 and second > OVERLAP_FRACTION * peak:
+            status = "overlap"
+            message = (f"two pulses in one contact: the force falls and rises again by {second:.3g} N "
+                       f"({second / peak:.0%} of the peak): two fruit, or a fruit and a rebound; no firmness")
+        elif status in ("ok", "clipped"):
+            shape = _shape_fit(own, analysis)
+            misfit = shape.get("fit_residual", math.nan) / impact.noise if impact.noise > 0 else math.nan
+            if shape.get("converged") and misfit > RESIDUAL_LIMIT:
+                status = "overlap"
+                message = (f"not one pulse: the force law leaves a residual of {misfit:.2g} x the noise (one "
+                           f"fruit leaves at most {RESIDUAL_LIMIT:g} x): two fruit landing together; no firmness")
+        if status == "overlap":
+            for key in FIRMNESS_KEYS:
+                report[key] = math.nan
+            report["contact_duration"] = (impact.end_index + 1 - impact.start_index) / analysis.rate
+        # what the rebound test knows of this contact (its impact speed is set once decided)
+        summary = None
+        if status in ("ok", "clipped"):
+            summary = from_indices(report, impact.sequence, impact.noise, None)
+            if summary is not None:
+                summary = refine(summary, shape)
+        history = self._history.setdefault(impact.lane, [])
+        verdict = None
+        if summary is not None and analysis.flight_limit > 0:
+            verdict = judge(summary, history, max_flight=analysis.flight_limit,
+                            last_fruit_onset=self._last_fruit.get(impact.lane), pitch=analysis.pitch)
+        rebound = verdict is not None and verdict.rebound
+        speed = analysis.velocity
+        if rebound:
+            index = next(i for i, s in enumerate(history) if s.sequence == verdict.parent)
+            parent = history[index]
+            history[index] = parent.taken()
+            speed = verdict.speed_ratio * parent.velocity if parent.velocity is not None else None
+        report.update(rebound=rebound, rebound_of=verdict.parent if rebound else None,
+                      rebound_ambiguous=bool(verdict is not None and verdict.ambiguous),
+                      rebound_evidence=verdict.evidence if verdict is not None else None)
+        if analysis.fit and shape is not None:
+            result = _restated(shape, analysis, speed)
+            _merge_fit(report, result)
+            if not result.get("converged") and status == "ok":
+                status, message = "unfitted", f"the fit did not converge: {result.get('message', '')}"
+            if speed is None and result.get("converged") and _finite(result.get("velocity")):
+                speed = result["velocity"]  # the mass was given: the fit found the speed
+        if summary is not None:
+            history.append(summary.with_velocity(speed))
+            # keep the contacts a later one could still be the rebound of
+            recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
+            history[:] = recent[-8:]
+        if not rebound and status != "overlap":
+            self._last_fruit[impact.lane] = report["start_time"]
+        if analysis.classes is not None:
+            graded = not rebound and status not in ("overlap", "truncated")
+            value = report.get(analysis.classes.by, math.nan)
+            report["class"] = analysis.classes.classify([value if _finite(value) else math.nan])[0] \
+                if graded else None
+            report["class_by"] = analysis.classes.by
+        report["status"] = status
+        report["message"] = message
         return report
+
+
+def isolated(impact: DetectedImpact) -> DetectedImpact:
+    """The impact with its window cut to its own samples: after the previous contact of the lane ended,
+    and before the next one began less the rise that contact had before crossing the threshold (taken
+    as 0.3 of this contact's own threshold-to-peak time, twice the rise of a Hertz pulse to 6 σ at
+    1 % noise, (0.06)^(2/3) ≈ 0.15 of its time to peak, plus 2 samples)."""
+    lo = impact.window_start
+    hi = impact.window_end
+    if impact.previous_end is not None:
+        lo = max(lo, min(impact.previous_end + 1, impact.start_index))
+    if impact.next_start is not None:
+        guard = math.ceil(0.3 * max(impact.peak_index - impact.start_index, 0)) + 2
+        hi = min(hi, max(impact.next_start - guard, impact.end_index + 1))
+    if lo == impact.window_start and hi == impact.window_end:
+        return impact
+    window = impact.window[lo - impact.window_start:hi - impact.window_start]
+    return dataclasses.replace(impact, window_start=lo, window=window)
+
+
+def _status(impact: DetectedImpact) -> tuple[str, str]:
+    if impact.truncated:
+        return "truncated", "the stream ended during this contact: its indices are incomplete"
+    if impact.overlong:
+        return "overlong", "the contact lasted longer than the detector's max_duration: ended there"
+    if impact.clipped:
+        return "clipped", "the signal reached the acquisition's limits during this contact: the peak is a lower bound"
+    return "ok", ""
+
+
+def _merge_fit(report: dict, result: dict) -> None:
+    for key in ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c",
+                "firmness_c_star", "impulse"):
+        if key in result and result.get("converged") and _finite(result[key]):
+            report[f"raw_{key}"] = report.get(key)
+            report[key] = result[key]
+    for key in FIT_KEYS:
+        if key in result:
+            report[key] = result[key]
+            report[f"{key}_stderr"] = result.get(f"{key}_stderr", math.nan)
+    report["fit_residual"] = result.get("fit_residual", math.nan)
+    report["fit_residual_relative"] = result.get("fit_residual_relative", math.nan)
+    report["fit_converged"] = bool(result.get("converged", False))
+    report["fit_message"] = result.get("message", "")
+    report["_fit"] = result  # the whole fit (for figures); not part of the JSON
 
 
 def public(report: dict) -> dict:
@@ -97,15 +257,31 @@ def _finite(value) -> bool:
     return isinstance(value, (int, float, np.floating)) and math.isfinite(float(value))
 
 
-def _fit(time, impact: DetectedImpact, analysis: Analysis, velocity) -> dict:
+def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
+    """The simulator's pulse fitted to the contact's own samples: with the given mass, or at a unit
+    velocity (the shape, indices and relative errors do not depend on it; ``_restated`` splits the
+    Hertz scales for the contact's real speed)."""
     from .fit import fit_impact
 
+    time = (impact.window_start + np.arange(impact.window.size)) / analysis.rate
     try:
-        return fit_impact(time, impact.window, velocity=velocity if analysis.mass is None else None,
-                          mass=analysis.mass,
-                          diameter=analysis.diameter, poisson=analysis.poisson, noise=impact.noise or None)
+        return fit_impact(time, impact.window, velocity=1.0 if analysis.mass is None else None,
+                          mass=analysis.mass, diameter=analysis.diameter, poisson=analysis.poisson,
+                          noise=impact.noise or None)
     except ValueError as exc:  # one bad pulse never stops the others
         return {"converged": False, "message": f"fit refused: {exc}"}
 
 
-__all__ = ["Analysis", "FIT_KEYS", "public"]
+def _restated(shape: dict, analysis: Analysis, velocity) -> dict:
+    """The shape fit for this contact's knowns: the given mass as it is, else its impact speed."""
+    from .fit import at_velocity
+
+    if analysis.mass is not None or not shape.get("converged"):
+        return shape
+    if velocity is None:
+        return {**shape, "converged": False,
+                "message": "a rebound whose first impact's speed is unknown: its mass and stiffness are not split"}
+    return at_velocity(shape, velocity)
+
+
+__all__ = ["Analysis", "FIT_KEYS", "LineAnalyzer", "REPORT_KEYS", "isolated", "public"]

@@ -37,12 +37,12 @@ Per sample and lane, in this order:
    samples; ``end_index`` is the last sample above that offset threshold.  A contact shorter than
    ``min_duration`` (end − start + 1 samples) is discarded; one longer than ``max_duration`` is ended
    there, flagged ``overlong``, and the detector re-learns the baseline (a new warm-up).
-6. **Rebounds**: an impact that starts at most ``rebound_window`` after the end of the previous impact
-   of its lane (start − previous end ≤ window, in samples) and has a smaller peak is a ``rebound`` of
-   it (``rebound_of`` = the previous impact's ``sequence``; the previous one gets ``rebound_by``).  A new
-   impact after the signal fell below the offset threshold for ``offset_hold`` is always a separate
-   impact, so closely spaced fruit are separate impacts (flagged rebound only if they also come within
-   the window with a smaller peak).
+6. **Neighbours**: each impact records the end of the previous impact of its lane (``previous_end``)
+   and, at emission, the onset of the next one when it began inside this impact's window
+   (``next_start``), so that the indices and the fit use only the samples that belong to it
+   (two fruit a few milliseconds apart are two impacts, never one fitted through both).  Whether an
+   impact is the rebound of an earlier one is not decided here but from the fruit's physics, after
+   the indices (``signals.rebounds``).
 
 Warm-up: the first ``warmup`` seconds of a lane (and the ``warmup`` after an overlong impact) only learn
 the baseline level and slope (from the medians of the two halves, or by least squares together with
@@ -51,22 +51,16 @@ start during a warm-up.  The stream should begin with that much quiet signal.
 
 Emission (what ``feed`` returns, and when)
 -----------------------------------------
-An impact i of a lane is emitted, as a ``DetectedImpact``, while processing the first sample n at which
-all of this holds:
-
-* its end has been confirmed (``offset_hold`` samples below the offset threshold, or ``max_duration``);
-* its window is complete: n ≥ end_index + post-trigger samples;
-* its rebound window has closed: either a later impact of the lane has ended (that impact's
-  ``rebound`` / ``rebound_of`` and impact i's ``rebound_by`` are then decided), or n ≥ end_index + W
-  (W = ``rebound_window`` in samples) and no impact that started within the window is still in progress.
-
-So an isolated impact is emitted at sample end_index + max(post, W) (``emitted_at`` = that + 1 samples
-consumed), and then every field is final.  Within a lane impacts are emitted in order; one ``feed``
-returns them sorted by (``emitted_at``, lane).  ``flush()`` ends the stream: an impact in progress is
-ended at its last sample above the offset threshold and emitted with ``truncated = True`` (regardless of
-``min_duration``), then every impact still held is emitted with the window cut at the last sample fed
-(``emitted_at`` = samples fed).  After ``flush`` the detector accepts no more samples (``reset()``
-starts a new stream).
+An impact of a lane is emitted, as a ``DetectedImpact``, while processing sample n = end_index +
+post-trigger samples: its end has been confirmed (``offset_hold`` samples below the offset threshold, or
+``max_duration``) and its window is complete.  Nothing waits for a later impact, so the latency from the
+last sample above the offset threshold to the emission is max(post-trigger, offset_hold) samples
+(``emitted_at`` = n + 1 samples consumed) and every field is final.  Within a lane impacts are emitted in
+order; one ``feed`` returns them sorted by (``emitted_at``, lane).  ``flush()`` ends the stream: an impact in
+progress is ended at its last sample above the offset threshold and emitted with ``truncated = True``
+(regardless of ``min_duration``), then every impact still held is emitted with the window cut at the last
+sample fed (``emitted_at`` = samples fed).  After ``flush`` the detector accepts no more samples
+(``reset()`` starts a new stream).
 
 The window of an impact holds the samples from start_index − pre-trigger to end_index + post-trigger
 (cut at the stream's start and, at flush, its end), low-pass filtered and with hum removed as
@@ -121,12 +115,11 @@ class DetectedImpact:
         subtracted (the baseline extrapolated linearly across the impact).
     noise : float
         Noise σ [N] at the onset.
-    rebound : bool
-        A rebound of the previous impact of the lane (see the module's rules).
-    rebound_of : int or None
-        ``sequence`` of the impact it is a rebound of.
-    rebound_by : int or None
-        ``sequence`` of the impact that is its rebound.
+    previous_end : int or None
+        ``end_index`` of the previous impact of the lane (None for its first).
+    next_start : int or None
+        ``start_index`` of the next impact of the lane when it began before this impact's window
+        ended (its samples from there on are not this impact's), else None.
     clipped : bool
         A raw sample reached ``clip_low``/``clip_high`` between the onset and the confirmed end.
     truncated : bool
@@ -152,9 +145,8 @@ class DetectedImpact:
     baseline: float
     baseline_slope: float
     noise: float
-    rebound: bool
-    rebound_of: int | None
-    rebound_by: int | None
+    previous_end: int | None
+    next_start: int | None
     clipped: bool
     truncated: bool
     overlong: bool
@@ -192,24 +184,24 @@ F_FIFO = F_HUM + 8
 FIFO_F = 4                      # peak value, baseline, noise, baseline slope
 P_PEAK, P_B, P_SIG, P_D = range(4)
 
-I_COUNT, I_STATE, I_WARMN, I_START, I_PEAKI, I_LAST, I_BELOW, I_CLIP, I_SEQ, I_NPEND, I_HEAD = range(11)
-I_FIFO = 11
-FIFO_I = 11
-Q_START, Q_END, Q_PEAKI, Q_SEQ, Q_REB, Q_REBOF, Q_REBBY, Q_CLIP, Q_TRUNC, Q_LONG, Q_NEXT = range(11)
+I_COUNT, I_STATE, I_WARMN, I_START, I_PEAKI, I_LAST, I_BELOW, I_CLIP, I_SEQ, I_NPEND, I_HEAD, I_PREV = range(12)
+I_FIFO = 12
+FIFO_I = 9
+Q_START, Q_END, Q_PEAKI, Q_SEQ, Q_PREV, Q_CLIP, Q_TRUNC, Q_LONG, Q_EMIT = range(9)
 
 S_WARM, S_QUIET, S_IN = 0, 1, 2
 
 # Output records
-O_LANE, O_SEQ, O_START, O_END, O_PEAKI, O_REB, O_REBOF, O_REBBY, O_CLIP, O_TRUNC, O_LONG, O_WSTART, O_WLEN, \
-    O_WOFF, O_EMIT = range(15)
-N_OI = 15
+O_LANE, O_SEQ, O_START, O_END, O_PEAKI, O_PREV, O_NEXT, O_CLIP, O_TRUNC, O_LONG, O_WSTART, O_WLEN, \
+    O_WOFF, O_EMIT = range(14)
+N_OI = 14
 N_OF = 4  # peak value, baseline, noise, baseline slope per sample
 
 # Parameters
 PF_AB, PF_AS, PF_KON, PF_KOFF, PF_FLOORON, PF_FLOOROFF, PF_G, PF_CW, PF_SW, PF_CLIPLO, PF_CLIPHI, PF_AD = range(12)
 N_PF = 12
-PI_HOLD, PI_MINLEN, PI_MAXLEN, PI_PRE, PI_POST, PI_W, PI_WARMN, PI_L, PI_FIFO, PI_NSEC, PI_NH, PI_MAXWIN = range(12)
-N_PI = 12
+PI_HOLD, PI_MINLEN, PI_MAXLEN, PI_PRE, PI_POST, PI_WARMN, PI_L, PI_FIFO, PI_NSEC, PI_NH, PI_MAXWIN = range(11)
+N_PI = 11
 
 #: E[min(|Z|, 3)] for a standard normal Z: the clipped mean absolute deviation of unit noise.
 CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / math.sqrt(2))
@@ -295,7 +287,7 @@ def _warm_fit(lane, gi, F, I, R, WY, WC, WS, harm, nh, L):
 
 @nb.njit(**_JIT)
 def _finish(lane, end, truncated, overlong, F, I, IP):
-    """End the impact in progress at ``end``: discard it (too short) or queue it, deciding rebounds."""
+    """End the impact in progress at ``end``: discard it (too short) or queue it for emission."""
     start = I[lane, I_START]
     if not truncated and not overlong and end - start + 1 < IP[PI_MINLEN]:
         return
@@ -305,32 +297,20 @@ def _finish(lane, end, truncated, overlong, F, I, IP):
         raise RuntimeError("detector FIFO overflow (internal error)")
     seq = I[lane, I_SEQ]
     I[lane, I_SEQ] = seq + 1
-    peak = F[lane, F_PEAK]
-    reb = 0
-    rebof = -1
-    if npend > 0:
-        prev = (I[lane, I_HEAD] + npend - 1) % fifo
-        pi0 = I_FIFO + prev * FIFO_I
-        I[lane, pi0 + Q_NEXT] = 1
-        if start - I[lane, pi0 + Q_END] <= IP[PI_W] and peak < F[lane, F_FIFO + prev * FIFO_F + P_PEAK]:
-            reb = 1
-            rebof = I[lane, pi0 + Q_SEQ]
-            I[lane, pi0 + Q_REBBY] = seq
     slot = (I[lane, I_HEAD] + npend) % fifo
     q = I_FIFO + slot * FIFO_I
     I[lane, q + Q_START] = start
     I[lane, q + Q_END] = end
     I[lane, q + Q_PEAKI] = I[lane, I_PEAKI]
     I[lane, q + Q_SEQ] = seq
-    I[lane, q + Q_REB] = reb
-    I[lane, q + Q_REBOF] = rebof
-    I[lane, q + Q_REBBY] = -1
+    I[lane, q + Q_PREV] = I[lane, I_PREV] - 1  # stored + 1 (0: none yet)
+    I[lane, I_PREV] = end + 1
     I[lane, q + Q_CLIP] = I[lane, I_CLIP]
     I[lane, q + Q_TRUNC] = 1 if truncated else 0
     I[lane, q + Q_LONG] = 1 if overlong else 0
-    I[lane, q + Q_NEXT] = 0
+    I[lane, q + Q_EMIT] = end + IP[PI_POST]
     f = F_FIFO + slot * FIFO_F
-    F[lane, f + P_PEAK] = peak
+    F[lane, f + P_PEAK] = F[lane, F_PEAK]
     F[lane, f + P_B] = F[lane, F_CB]
     F[lane, f + P_SIG] = F[lane, F_CSIG]
     F[lane, f + P_D] = F[lane, F_CD]
@@ -339,7 +319,8 @@ def _finish(lane, end, truncated, overlong, F, I, IP):
 
 @nb.njit(**_JIT)
 def _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt):
-    """Emit the oldest queued impact of the lane after sample ``gi`` (window cut at gi)."""
+    """Emit the oldest queued impact of the lane after sample ``gi`` (window cut at gi), with the onset of
+    the next impact of the lane when it began inside the window."""
     fifo = IP[PI_FIFO]
     L = IP[PI_L]
     slot = I[lane, I_HEAD]
@@ -353,6 +334,13 @@ def _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt):
     ws = max(ws, 0)
     we = end + IP[PI_POST]
     we = min(we, gi)
+    nxt = -1
+    if I[lane, I_NPEND] > 1:
+        nxt = I[lane, I_FIFO + ((slot + 1) % fifo) * FIFO_I + Q_START]
+    elif I[lane, I_STATE] == S_IN and I[lane, I_START] > end:
+        nxt = I[lane, I_START]
+    if nxt > we:
+        nxt = -1
     b = F[lane, f + P_B]
     d = F[lane, f + P_D]
     k = cnt[0]
@@ -368,9 +356,8 @@ def _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt):
     OI[k, O_START] = start
     OI[k, O_END] = end
     OI[k, O_PEAKI] = I[lane, q + Q_PEAKI]
-    OI[k, O_REB] = I[lane, q + Q_REB]
-    OI[k, O_REBOF] = I[lane, q + Q_REBOF]
-    OI[k, O_REBBY] = I[lane, q + Q_REBBY]
+    OI[k, O_PREV] = I[lane, q + Q_PREV]
+    OI[k, O_NEXT] = nxt
     OI[k, O_CLIP] = I[lane, q + Q_CLIP]
     OI[k, O_TRUNC] = I[lane, q + Q_TRUNC]
     OI[k, O_LONG] = I[lane, q + Q_LONG]
@@ -403,8 +390,6 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
     clip_hi = PF[PF_CLIPHI]
     hold = IP[PI_HOLD]
     maxlen = IP[PI_MAXLEN]
-    post = IP[PI_POST]
-    W = IP[PI_W]
     warm_n = IP[PI_WARMN]
     L = IP[PI_L]
     fifo = IP[PI_FIFO]
@@ -520,17 +505,8 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
                 pc *= norm
                 ps *= norm
             # emission of the queued impacts that are final
-            while I[lane, I_NPEND] > 0:
-                slot = I[lane, I_HEAD]
-                q = I_FIFO + slot * FIFO_I
-                end = I[lane, q + Q_END]
-                if gi < end + post:
-                    break
-                if I[lane, q + Q_NEXT] == 0:
-                    if gi < end + W:
-                        break
-                    if state == S_IN and I[lane, I_START] <= end + W:
-                        break
+            I[lane, I_STATE] = state  # read by _emit_head (an impact in progress is the next one)
+            while I[lane, I_NPEND] > 0 and gi >= I[lane, I_FIFO + I[lane, I_HEAD] * FIFO_I + Q_EMIT]:
                 _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt)
             gi += 1
             k += 1
@@ -599,7 +575,6 @@ class Detector:
                              f"in samples at {rate:g} Hz; got {s.max_duration!r} s")
         pre = _samples("pre_trigger", s.pre_trigger, rate, 0)
         post = _samples("post_trigger", s.post_trigger, rate, 0)
-        window = _samples("rebound_window", s.rebound_window, rate, 0)
         warm_n = _samples("warmup", s.warmup, rate, 16)
         harm = np.array(s.hum_harmonics if s.hum_frequency is not None else (), dtype=np.int64)
         gain = 0.0
@@ -615,7 +590,7 @@ class Detector:
         sos = (butterworth_sos(s.lowpass_cutoff, s.lowpass_order, rate) if s.lowpass_cutoff is not None
                else np.zeros((0, 6)))
         fifo = post // (min_len + hold) + 4
-        ring = pre + max_len + max(post, window + max_len + hold) + 2
+        ring = pre + max_len + post + hold + 2
         self._maxwin = pre + max_len + post + 1
         omega = 2 * math.pi * (s.hum_frequency or 0.0) / rate
         decay = math.exp(-1 / (s.baseline_time_constant * rate))
@@ -625,12 +600,12 @@ class Detector:
                              gain, math.cos(omega), math.sin(omega),
                              -math.inf if s.clip_low is None else s.clip_low,
                              math.inf if s.clip_high is None else s.clip_high, (1 - decay) ** 2])
-        self._pi = np.array([hold, min_len, max_len, pre, post, window, warm_n, ring, fifo, sos.shape[0],
+        self._pi = np.array([hold, min_len, max_len, pre, post, warm_n, ring, fifo, sos.shape[0],
                              harm.shape[0], self._maxwin], dtype=np.int64)
         self._harm, self._sos = harm, np.ascontiguousarray(sos)
         self._fifo, self._ring_len, self._warm_n = fifo, ring, warm_n
-        #: Samples between an isolated impact's end_index and its emission (max(post, rebound window)).
-        self.latency_samples = max(post, window)
+        #: Samples between an impact's end_index and its emission (max(post-trigger, offset hold)).
+        self.latency_samples = max(post, hold)
         self.reset()
 
     def reset(self) -> None:
@@ -720,9 +695,9 @@ class Detector:
             impacts.append(DetectedImpact(
                 lane=row[O_LANE], sequence=row[O_SEQ], start_index=row[O_START], end_index=row[O_END],
                 peak_index=row[O_PEAKI], peak_value=float(of[k, 0]), baseline=float(of[k, 1]),
-                baseline_slope=float(of[k, 3]) * self.rate, noise=float(of[k, 2]), rebound=bool(row[O_REB]),
-                rebound_of=None if row[O_REBOF] < 0 else row[O_REBOF],
-                rebound_by=None if row[O_REBBY] < 0 else row[O_REBBY],
+                baseline_slope=float(of[k, 3]) * self.rate, noise=float(of[k, 2]), 
+                previous_end=None if row[O_PREV] < 0 else row[O_PREV],
+                next_start=None if row[O_NEXT] < 0 else row[O_NEXT],
                 clipped=bool(row[O_CLIP]), truncated=bool(row[O_TRUNC]), overlong=bool(row[O_LONG]),
                 window_start=row[O_WSTART], window=window, emitted_at=row[O_EMIT]))
         self._cnt[:] = 0

@@ -66,7 +66,8 @@ from ..engine.powerlaw import (
     powerlaw_single,
 )
 
-__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "fit_impact", "model_curve", "shape_table_error"]
+__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve",
+           "shape_table_error"]
 
 #: Largest x = c·V the fit explores (e ≈ 0.100); the projection keeps x in [0, X_MAX].
 X_MAX = 10.0
@@ -648,6 +649,29 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
                   samples_in_contact=inside, converged=bool(converged), iterations=int(iterations),
                   message="; ".join([message] + notes))
     return result
+
+
+def at_velocity(result: dict, velocity: float) -> dict:
+    """A ``fit_impact`` result obtained with one impact velocity, restated for another [m/s].
+
+    The fit itself (θ = t0, F_max, T, x) does not depend on the velocity; only the split of the Hertz
+    scales does (module docstring): δ_H = V t_H, so K ∝ V^-1.5, m ∝ 1/V, c = x/V and E ∝ K, each with
+    the same relative standard error (V is exact when given), and the indices are unchanged.  Exact, so
+    one fit serves the shape (the rebound test) and the line's knowns alike."""
+    velocity = _positive("velocity", velocity)
+    if not (result.get("velocity_stderr") == 0.0 and _finite_positive(result.get("velocity"))):
+        raise ValueError("at_velocity restates a fit that was given the velocity (velocity_stderr 0)")
+    ratio = velocity / result["velocity"]
+    out = dict(result)
+    for name, power in (("stiffness", -1.5), ("modulus", -1.5), ("mass", -1.0), ("damping_factor", -1.0)):
+        out[name] = result[name] * ratio ** power
+        out[name + "_stderr"] = result[name + "_stderr"] * ratio ** power
+    out["velocity"] = velocity
+    return out
+
+
+def _finite_positive(value) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value) and value > 0
 
 
 def model_curve(time, result: dict) -> np.ndarray:

@@ -40,9 +40,6 @@ class DetectorSettings:
         Longest contact [s]: longer ones are ended (``overlong``) and the baseline is re-learnt. Default 0.1.
     pre_trigger, post_trigger : float
         Margins [s] kept in the window before the onset and after the end. Default 2e-3 each.
-    rebound_window : float
-        [s] from the previous impact's end within which a smaller impact is its rebound; also the
-        time an impact is held before emission. 0 disables rebound detection. Default 0.1.
     hum_frequency : float or None
         Mains frequency [Hz] (50 or 60) of the hum to remove; None (default): no hum removal.
     hum_q : float
@@ -70,7 +67,6 @@ class DetectorSettings:
     max_duration: float = 0.1
     pre_trigger: float = 2e-3
     post_trigger: float = 2e-3
-    rebound_window: float = 0.1
     hum_frequency: float | None = None
     hum_q: float = 10.0
     hum_harmonics: tuple = (1,)
@@ -88,9 +84,8 @@ class DetectorSettings:
                      "max_duration", "k_on"):
             number(name, 0)
         number("k_off", 0, self.k_on)
-        for name in ("threshold_floor", "pre_trigger", "post_trigger", "rebound_window"):
+        for name in ("threshold_floor", "pre_trigger", "post_trigger"):
             number(name, 0, low_open=False)
-        number("rebound_window", 0, 60.0, low_open=False, high_open=False)
         number("max_duration", self.min_duration, 60.0, high_open=False)
         number("hum_frequency", 0, optional=True)
         number("hum_q", 0.5)

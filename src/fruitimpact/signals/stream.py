@@ -4,13 +4,16 @@
   commas.  A malformed line (wrong count of numbers, something that is not a number, NaN or infinity)
   is skipped and counted; the first line with each kind of problem is reported through ``on_problem``
   (one message per kind), the rest only counted.  Blank lines are skipped silently.  A skipped line
-  removes one sample, so later samples move 1/rate earlier.
+  removes one sample, so later samples move 1/rate earlier.  Input that is not text at all (NUL bytes
+  or invalid UTF-8 in most of the first ``BINARY_LINES`` lines, as raw float32 is) ends the stream with
+  one ``ValueError``: "looks like binary: give --format f32".
 * ``Float32Source``: raw little-endian float32, lanes interleaved (sample 0 lane 0, sample 0 lane 1, …).
   A sample cut by a read boundary waits for the next read; bytes left at the end are reported and
   dropped.  A NaN or infinite value is replaced by the lane's previous value (0 before any) and reported
   once, so the timing of later samples is kept.
-* ``StreamAnalyzer``: a ``Detector`` plus ``impact_indices``: each impact becomes one dict (the keys of
-  ``indices.INDEX_KEYS``) passed to ``on_impact``.  ``run(chunks)`` consumes an iterable of byte chunks,
+* ``StreamAnalyzer``: a ``Detector`` plus an ``analysis.Analysis``: each contact becomes one report (the
+  raw indices, the rebound decision, the fit and the class as configured) passed to ``on_impact`` as
+  soon as the detector emits it.  ``run(chunks)`` consumes an iterable of byte chunks,
   and on its end, on SIGTERM or on Ctrl-C (SIGINT) flushes the detector — emitting the impact in
   progress as ``truncated`` and everything held — before it returns a summary.
 * ``serve(port, ...)``: a TCP server on 127.0.0.1 that takes one client at a time and analyses its bytes
@@ -30,12 +33,16 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from .analysis import Analysis
 from .detect import DetectedImpact, Detector, DetectorSettings
-from .indices import impact_indices
 
 __all__ = ["Float32Source", "StreamAnalyzer", "TextSource", "iter_chunks", "serve"]
 
 CHUNK_SIZE = 1 << 16
+#: Lines after which text input that is mostly not text is refused as binary.
+BINARY_LINES = 256
+#: Longest text line accepted [bytes].
+MAX_LINE = 1 << 16
 
 
 def _default_problem(message: str) -> None:
@@ -88,11 +95,17 @@ class TextSource(_Source):
         self.samples = 0
         self.malformed = 0
         self._line_number = 0
+        self._binary_lines = 0
 
     def parse(self, chunk: bytes) -> np.ndarray:
         data = self._partial + bytes(chunk)
         cut = data.rfind(b"\n")
         if cut < 0:
+            if len(data) > MAX_LINE:
+                binary = b"\x00" in data or "\ufffd" in data.decode("utf-8", errors="replace")
+                raise ValueError("argument --format: the input looks like binary (no line end in its first "
+                                 f"{len(data)} bytes): give --format f32 for raw float32" if binary else
+                                 f"a text line longer than {MAX_LINE} bytes: one sample per line is expected")
             self._partial = data
             return np.empty((0, self.lanes))
         self._partial = data[cut + 1:]
@@ -105,6 +118,8 @@ class TextSource(_Source):
     def _parse_lines(self, data: bytes) -> np.ndarray:
         text = data.decode("utf-8", errors="replace")
         raw_lines = text.split("\n")
+        if self._line_number < BINARY_LINES:
+            self._check_text(raw_lines[:BINARY_LINES - self._line_number])
         if raw_lines and raw_lines[-1] == "":
             raw_lines.pop()
         first_number = self._line_number + 1
@@ -143,6 +158,14 @@ class TextSource(_Source):
             rows.append(row)
         self.samples += len(rows)
         return np.array(rows, dtype=float).reshape(len(rows), lanes)
+
+    def _check_text(self, raw_lines: list[str]) -> None:
+        """Refuse input that is mostly not text within its first BINARY_LINES lines (module docstring)."""
+        self._binary_lines += sum(1 for line in raw_lines if "\x00" in line or "\ufffd" in line)
+        lines = self._line_number + len(raw_lines)
+        if self._binary_lines > 8 and self._binary_lines > lines // 2:
+            raise ValueError(f"argument --format: the input looks like binary ({self._binary_lines} of its first "
+                             f"{lines} lines hold NUL bytes or invalid UTF-8): give --format f32 for raw float32")
 
     def _bad(self, kind: str, message: str) -> None:
         self.malformed += 1
@@ -255,7 +278,7 @@ class _SignalGuard:
 
 
 class StreamAnalyzer:
-    """Detector + indices over a byte stream (module docstring).
+    """Detector + analysis over a byte stream or parsed samples (module docstring).
 
     Parameters
     ----------
@@ -266,25 +289,43 @@ class StreamAnalyzer:
     settings : DetectorSettings, optional
         Detector settings (defaults if None).
     on_impact : callable, optional
-        Called with each impact's dict of indices (``indices.INDEX_KEYS``), in emission order.  If None,
-        the dicts are collected in ``results``.
+        Called with each contact's report (``analysis.LineAnalyzer.report``, its ``lane`` the lane's
+        name), in emission order.  If None, the reports are collected in ``results``.
     source : "text" or "float32"
         Input format (``TextSource`` or ``Float32Source``).
     on_problem : callable, optional
         Called with one line per kind of input problem (default: print to stderr).
     on_detected : callable, optional
-        Also called with each ``DetectedImpact`` and its dict (e.g. for a model fit of its window).
+        Also called with each ``DetectedImpact`` and its report (e.g. for a figure of its window).
+    analysis : Analysis, optional
+        How each contact is analysed (default: ``Analysis(rate)``: raw indices and rebounds).
+    lane_names : sequence of str, optional
+        The lanes' names in the reports (default ``lane0``, ``lane1``, …).
+    start_time : float
+        Time of the first sample [s], added to the reports' ``start_time`` (default 0).
     """
 
     def __init__(self, rate: float, lanes: int = 1, settings: DetectorSettings | None = None,
                  on_impact: Callable[[dict], None] | None = None, *, source: str = "text",
                  on_problem: Callable[[str], None] | None = None,
-                 on_detected: Callable[[DetectedImpact, dict], None] | None = None):
+                 on_detected: Callable[[DetectedImpact, dict], None] | None = None,
+                 analysis: Analysis | None = None, lane_names=None, start_time: float = 0.0):
         if source not in _SOURCES:
             raise ValueError(f"source must be one of {', '.join(map(repr, _SOURCES))}; got {source!r}")
         self.detector = Detector(rate, settings, lanes)
         self.rate = self.detector.rate
         self.lanes = self.detector.lanes
+        if analysis is None:
+            analysis = Analysis(self.rate)
+        if not isinstance(analysis, Analysis) or analysis.rate != self.rate:
+            raise ValueError("analysis must be an Analysis at the stream's rate")
+        self.analysis = analysis
+        self._analyzer = analysis.analyzer()
+        names = tuple(lane_names) if lane_names is not None else tuple(f"lane{k}" for k in range(self.lanes))
+        if len(names) != self.lanes:
+            raise ValueError(f"lane_names must name the {self.lanes} lane(s); got {len(names)} name(s)")
+        self.lane_names = names
+        self.start_time = float(start_time)
         self.source = _SOURCES[source](self.lanes, on_problem)
         self.results: list[dict] = []
         self.on_impact = on_impact if on_impact is not None else self.results.append
@@ -313,11 +354,16 @@ class StreamAnalyzer:
 
     def _emit(self, impacts: list[DetectedImpact]) -> int:
         for impact in impacts:
-            values = impact_indices(impact, self.rate)
+            report = self._analyzer.report(impact)
+            report["lane"] = self.lane_names[impact.lane]
+            if self.start_time:
+                for key in ("start_time", "raw_start_time"):
+                    if key in report:
+                        report[key] += self.start_time
             self.impacts += 1
             if self.on_detected is not None:
-                self.on_detected(impact, values)
-            self.on_impact(values)
+                self.on_detected(impact, report)
+            self.on_impact(report)
         return len(impacts)
 
     def run(self, chunks: Iterable[bytes]) -> dict:
@@ -364,11 +410,12 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
           on_problem: Callable[[str], None] | None = None, host: str = "127.0.0.1",
           max_clients: int | None = None, on_listening: Callable[[int], None] | None = None,
           on_client: Callable[[tuple, dict], None] | None = None,
-          on_detected: Callable[[DetectedImpact, dict], None] | None = None) -> list[dict]:
+          on_detected: Callable[[DetectedImpact, dict], None] | None = None,
+          analysis: Analysis | None = None) -> list[dict]:
     """Listen on ``host``:``port`` (0: any free port) and analyse each client's bytes as one stream, one
     client at a time, until ``max_clients`` clients were served (None: until SIGTERM/SIGINT).
 
-    ``on_impact``, ``source``, ``on_problem`` and ``on_detected`` are those of ``StreamAnalyzer``;
+    ``on_impact``, ``source``, ``on_problem``, ``on_detected`` and ``analysis`` are those of ``StreamAnalyzer``;
     ``on_listening(port)`` is called once the socket listens; ``on_client(address, summary)`` after each
     client.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
     the socket is opened.
@@ -378,7 +425,8 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
     if max_clients is not None and (isinstance(max_clients, bool) or not isinstance(max_clients, (int, np.integer))
                                     or max_clients < 1):
         raise ValueError(f"max_clients must be None or an integer >= 1; got {max_clients!r}")
-    StreamAnalyzer(rate, lanes, settings, on_impact, source=source, on_problem=on_problem)  # checks the arguments
+    StreamAnalyzer(rate, lanes, settings, on_impact, source=source, on_problem=on_problem,
+                   analysis=analysis)  # checks the arguments
     summaries: list[dict] = []
     with _SignalGuard() as guard, socket.create_server((host, port)) as server:
         if on_listening is not None:
@@ -388,7 +436,7 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
                 connection, address = server.accept()
                 with connection:
                     analyzer = StreamAnalyzer(rate, lanes, settings, on_impact, source=source,
-                                              on_problem=on_problem, on_detected=on_detected)
+                                              on_problem=on_problem, on_detected=on_detected, analysis=analysis)
                     summary = _serve_client(analyzer, connection, guard)
                 summaries.append(summary)
                 if on_client is not None:

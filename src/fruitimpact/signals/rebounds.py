@@ -1,0 +1,280 @@
+"""Is a contact a new fruit or the rebound of an earlier one?  Decided by the fruit's own physics
+(issue 13, item 1), never by "smaller and soon".
+
+A fruit that leaves the plate at V₂ flies 2 V₂/g (no drag) and lands again as the *same* fruit: the
+same mass m, contact stiffness K and Hunt–Crossley damping factor c (a material constant), at the lower
+speed.  For the force law F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale
+times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
+
+    F_max = K δ_H^1.5 · P(x)/1.25,   t_c = t_H · τ_c(x),   T = t_H · τ_T(x),   ∫F dt = m V (1 + e(x)),
+
+with P, τ_c, τ_T, e the dimensionless peak, time to peak, duration and restitution of the exact engine
+(m = V = 1, K = 1.25).  So if a contact j is the rebound of contact p at the speed ratio r = V_j/V_p:
+
+    x_j = r x_p,
+    F_j / F_p  = r^1.2  · P(r x_p)/P(x_p),
+    t_cj/t_cp  = r^-0.2 · τ_c(r x_p)/τ_c(x_p),
+    I_j / I_p  = r · (1 + e(r x_p))/(1 + e(x_p)),
+
+none of which needs m, K or V.  The impulse ratio gives r (it does not depend on where the fruit lands on
+itself); the peak force, the time to peak and the shape x must then agree with it, r must be the
+restitution of p (r ≈ e_p: the fruit cannot come back faster, and spin or an off-axis bounce take a
+little), and, when p's impact speed is known (the line's drop height, or a fitted velocity), the
+observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
+
+Each test gives a deviation in units of its tolerance; the score S of the hypothesis is the largest.
+Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
+
+* flight: ±25 % (a spinning or off-axis fruit's flight is off by ±10–20 %; the estimate of r adds its
+  own error in quadrature);
+* speed ratio r against e_p: −25 % / +10 % (energy lost to spin and tangential motion lowers the
+  vertical rebound speed, nothing raises it: a fruit cannot come back faster than it left; e_p itself
+  is uncertain by its standard error, added in quadrature);
+* peak force and time to peak: 3 × √(σ_meas² + 4 %²), the 4 % for a rebound landing on another spot
+  of the fruit (local radius and modulus ±10 % move F_max and t_c by ~4 %: both go as K^±0.4);
+* shape: x_j against r x_p within 3 × √(σ_j² + (r σ_p)² + (0.1 r x_p)²).
+
+S ≤ 1: a rebound.  S > 1: a new fruit.  Near the boundary (``AMBIGUOUS`` band) the decision is kept but
+flagged ambiguous, with the evidence (predicted and observed flight and peak).  A known feed
+(``pitch``) is a prior: a contact on the pitch grid of the lane's last fruit needs S ≤ 0.8 to be a
+rebound, one far off the grid S ≤ 1.25; without it the rule above alone decides.
+
+The measurements are the raw indices (``from_indices``), with or without a model fit, so that the
+decision is the same either way and is known before the fit (which then uses the rebound's speed r V_p).
+The shape x is read from h = ∫F dt / (F_max t_c), which for the force law is (1 + e(x))/(P(x) τ_c(x)), a
+function of x alone, increasing up to x ≈ 2.6 (e ≈ 0.35) and flat near its top, so the raw x is weak
+for e ≈ 0.35–0.5 (its uncertainty is propagated).  So where a shape fit of the contact converged (the
+simulator's pulse fitted to its own samples, e ± 0.01 at 1 % noise; ``analysis`` fits every contact,
+with or without ``--fit``) its x, e and separation time replace the raw ones (``refine``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..constants import STANDARD_GRAVITY
+
+__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "refine", "shape_table"]
+
+#: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
+#: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
+TOLERANCES = {"flight": 0.25, "speed_ratio": 0.25, "speed_ratio_up": 0.10, "spot": 0.04, "shape": 0.10, "z": 3.0}
+#: Scores in this band around 1 mark the decision ambiguous (kept, with the evidence).
+AMBIGUOUS = (0.8, 1.25)
+#: Relative measurement uncertainties of the raw indices (indices.py: F_max sd ≈ 0.3 %, t_c ≈ 0.7 %,
+#: impulse ≈ 0.25 % at 1 % noise; doubled for margin) used when the noise is not worse.
+RAW_SD = {"peak_force": 0.006, "time_to_peak": 0.014, "impulse": 0.005}
+_X_MAX = 10.0
+_TABLE: list = []
+
+
+def shape_table() -> dict:
+    """The dimensionless characteristics of the force law against x = c V (built once, from the exact
+    engine's batch path): ``x``, ``e``, ``P`` (peak), ``tc``, ``T`` and ``h`` = (1 + e)/(P τ_c)."""
+    if not _TABLE:
+        from ..engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
+        from ..engine.powerlaw import powerlaw_characteristics
+
+        x = np.expm1(np.linspace(0.0, math.log1p(_X_MAX), 801))
+        one = np.ones_like(x)
+        values = powerlaw_characteristics(one, 1.25 * one, x, one, one)
+        e = values[:, RESTITUTION]
+        peak, tc, duration = values[:, PEAK_FORCE], values[:, TIME_TO_PEAK], values[:, CONTACT_DURATION]
+        _TABLE.append({"x": x, "e": e, "P": peak, "tc": tc, "T": duration, "h": (1.0 + e) / (peak * tc)})
+    return _TABLE[0]
+
+
+def _at(name: str, x: float) -> float:
+    table = shape_table()
+    return float(np.interp(x, table["x"], table[name]))
+
+
+def _x_of_h(h: float) -> tuple[float, float]:
+    """x from h on its increasing branch, and dx/dh there (inf on the flat top)."""
+    table = shape_table()
+    top = int(np.argmax(table["h"]))
+    hs, xs = table["h"][:top + 1], table["x"][:top + 1]
+    if h <= hs[0]:
+        return 0.0, float((xs[1] - xs[0]) / (hs[1] - hs[0]))
+    if h >= hs[-1]:
+        return float(xs[-1]), math.inf
+    k = int(np.searchsorted(hs, h))
+    slope = (xs[k] - xs[k - 1]) / (hs[k] - hs[k - 1])
+    return float(xs[k - 1] + (h - hs[k - 1]) * slope), float(slope)
+
+
+@dataclass(frozen=True)
+class PulseSummary:
+    """What the rebound test knows of one contact (SI units; ``*_sd`` relative except ``x_sd``).
+
+    onset [s] and separation [s] (onset + T) on the stream's clock; peak_force [N]; time_to_peak [s];
+    impulse [N s]; x = c V and its absolute sd; restitution e and its sd; velocity [m/s] of the impact
+    when known (the line's, a fitted one, or r V of the contact it rebounds from), else None."""
+
+    sequence: int
+    onset: float
+    separation: float
+    peak_force: float
+    time_to_peak: float
+    impulse: float
+    x: float
+    restitution: float
+    peak_force_sd: float
+    time_to_peak_sd: float
+    impulse_sd: float
+    x_sd: float
+    restitution_sd: float
+    velocity: float | None = None
+    rebound_taken: bool = False
+    refined: bool = False
+
+    def with_velocity(self, velocity: float | None) -> PulseSummary:
+        return replace(self, velocity=velocity)
+
+    def taken(self) -> PulseSummary:
+        """The same contact, marked as already having its rebound (a contact rebounds once)."""
+        return replace(self, rebound_taken=True)
+
+
+def _finite(*values) -> bool:
+    return all(isinstance(v, (int, float, np.floating)) and math.isfinite(float(v)) for v in values)
+
+
+def from_indices(report: dict, sequence: int, noise: float, velocity: float | None) -> PulseSummary | None:
+    """The summary of a contact from its raw indices (``indices.impact_indices``) and the noise sd [N];
+    None when an index needed is missing (a truncated or too weak pulse)."""
+    onset, peak, tc, impulse = (report.get(k) for k in ("start_time", "peak_force", "time_to_peak", "impulse"))
+    if not _finite(onset, peak, tc, impulse) or not (peak > 0 and tc > 0 and impulse > 0):
+        return None
+    snr = noise / peak if noise > 0 else 0.0
+    peak_sd = math.hypot(RAW_SD["peak_force"], 0.5 * snr)
+    tc_sd = math.hypot(RAW_SD["time_to_peak"], 1.5 * snr)
+    impulse_sd = math.hypot(RAW_SD["impulse"], 0.4 * snr)
+    h = impulse / (peak * tc)
+    x, slope = _x_of_h(h)
+    h_sd = h * math.sqrt(peak_sd ** 2 + tc_sd ** 2 + impulse_sd ** 2)
+    x_sd = min(abs(slope) * h_sd, _X_MAX)
+    e = _at("e", x)
+    e_sd = min(abs(_at("e", x + x_sd) - _at("e", max(x - x_sd, 0.0))) / 2.0, 1.0)
+    duration = tc * _at("T", x) / _at("tc", x)
+    return PulseSummary(sequence=sequence, onset=onset, separation=onset + duration, peak_force=peak,
+                        time_to_peak=tc, impulse=impulse, x=x, restitution=e, peak_force_sd=peak_sd,
+                        time_to_peak_sd=tc_sd, impulse_sd=impulse_sd, x_sd=x_sd, restitution_sd=e_sd,
+                        velocity=velocity)
+
+
+def refine(summary: PulseSummary, fit: dict) -> PulseSummary:
+    """The summary with x, e and the separation time of a converged shape fit of the same contact (a
+    ``fit.fit_impact`` result: its x = c V, restitution and contact times do not depend on the velocity
+    or mass it was given); unchanged when the fit did not converge."""
+    if not fit.get("converged") or not _finite(fit.get("restitution_stderr"), fit.get("damping_factor"),
+                                               fit.get("velocity")):
+        return summary
+    x = float(fit["damping_factor"] * fit["velocity"])
+    e, e_sd = float(fit["restitution"]), max(float(fit["restitution_stderr"]), 0.003)
+    slope = abs(_at("e", x + 1e-3) - _at("e", max(x - 1e-3, 0.0))) / (x + 1e-3 - max(x - 1e-3, 0.0))
+    x_sd = max(e_sd / slope if slope > 0 else 0.1 * x, 1e-3)
+    return replace(summary, x=x, x_sd=x_sd, restitution=e, restitution_sd=e_sd,
+                   separation=float(fit["start_time"] + fit["contact_duration"]), refined=True)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The decision on one contact: ``rebound`` of ``parent`` (its sequence) or a new fruit,
+    ``ambiguous`` near the boundary, ``speed_ratio`` r = V_j/V_p when a rebound, and the ``evidence``
+    (a JSON-able dict: parent, observed and predicted flight [s] and peak [N], r, e_p, each test's
+    deviation in units of its tolerance, the score, the threshold used)."""
+
+    rebound: bool
+    parent: int | None
+    ambiguous: bool
+    speed_ratio: float | None
+    evidence: dict | None
+
+
+NEW_FRUIT = Verdict(False, None, False, None, None)
+
+
+def _speed_ratio(candidate: PulseSummary, parent: PulseSummary) -> float:
+    """r solving I_j/I_p = r (1 + e(r x_p))/(1 + e_p) (a few fixed-point steps: the e term moves slowly)."""
+    ratio = candidate.impulse / parent.impulse
+    r = ratio
+    for _ in range(8):
+        r = ratio * (1.0 + parent.restitution) / (1.0 + _at("e", r * parent.x))
+    return r
+
+
+def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
+    """Deviations (in tolerances) of "candidate is parent's rebound", and what they compare."""
+    tol = TOLERANCES
+    r = _speed_ratio(candidate, parent)
+    xr = r * parent.x
+    peak_pred = parent.peak_force * r ** 1.2 * _at("P", xr) / _at("P", parent.x)
+    tc_pred = parent.time_to_peak * r ** -0.2 * _at("tc", xr) / _at("tc", parent.x)
+    r_sd = math.hypot(candidate.impulse_sd, parent.impulse_sd)
+    z = tol["z"]
+    excess = math.log(r / parent.restitution)
+    deviations = {
+        "speed_ratio": abs(excess) / math.hypot(tol["speed_ratio_up" if excess > 0 else "speed_ratio"],
+                                                z * parent.restitution_sd / parent.restitution, z * r_sd),
+        "peak_force": abs(math.log(candidate.peak_force / peak_pred))
+        / (z * math.sqrt(candidate.peak_force_sd ** 2 + parent.peak_force_sd ** 2 + (1.2 * r_sd) ** 2
+                         + tol["spot"] ** 2)),
+        "time_to_peak": abs(math.log(candidate.time_to_peak / tc_pred))
+        / (z * math.sqrt(candidate.time_to_peak_sd ** 2 + parent.time_to_peak_sd ** 2 + tol["spot"] ** 2)),
+        "shape": abs(candidate.x - xr)
+        / (z * math.sqrt(candidate.x_sd ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2) + 1e-12),
+    }
+    flight = candidate.onset - parent.separation
+    evidence = {"parent": parent.sequence, "flight_observed": flight, "flight_predicted": None,
+                "peak_observed": candidate.peak_force, "peak_predicted": peak_pred, "speed_ratio": r,
+                "restitution_parent": parent.restitution}
+    if parent.velocity is not None:
+        predicted = 2.0 * r * parent.velocity / STANDARD_GRAVITY
+        evidence["flight_predicted"] = predicted
+        deviations["flight"] = abs(math.log(flight / predicted)) / math.hypot(tol["flight"], r_sd) \
+            if flight > 0 else math.inf
+    elif not flight > 0:
+        deviations["flight"] = math.inf
+    evidence["deviations"] = {k: round(v, 3) if math.isfinite(v) else None for k, v in deviations.items()}
+    evidence["score"] = max(deviations.values())
+    return evidence
+
+
+def _threshold(candidate: PulseSummary, last_fruit_onset: float | None, pitch: float | None) -> tuple[float, str]:
+    """The score a rebound must stay under, from the feed prior (module docstring)."""
+    if pitch is None or last_fruit_onset is None:
+        return 1.0, "none"
+    cycles = (candidate.onset - last_fruit_onset) / pitch
+    phase = abs(cycles - round(cycles)) if cycles >= 0.5 else math.inf
+    if phase <= 0.15:
+        return 0.8, f"on the feed's pitch ({cycles:.2f} pitches after the last fruit)"
+    if phase >= 0.3:
+        return 1.25, f"off the feed's pitch ({cycles:.2f} pitches after the last fruit)"
+    return 1.0, f"{cycles:.2f} pitches after the last fruit"
+
+
+def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: float,
+          last_fruit_onset: float | None = None, pitch: float | None = None) -> Verdict:
+    """Decide whether ``candidate`` is the rebound of one of the ``earlier`` contacts of its lane (most
+    recent last; those whose separation is more than ``max_flight`` [s] before its onset, and those that
+    already have their rebound, are not considered).  The best-scoring parent wins (module docstring)."""
+    threshold, prior = _threshold(candidate, last_fruit_onset, pitch)
+    parents = [p for p in reversed(earlier) if not p.rebound_taken and p.onset < candidate.onset
+               and candidate.onset - p.separation <= max_flight]
+    best = min((_hypothesis(candidate, p) for p in parents), key=lambda ev: ev["score"], default=None)
+    if best is None:
+        return NEW_FRUIT
+    score = best["score"]
+    best["threshold"] = threshold
+    best["feed_prior"] = prior
+    best["score"] = round(score, 3) if math.isfinite(score) else None
+    rebound = score <= threshold
+    ambiguous = AMBIGUOUS[0] * threshold < score <= AMBIGUOUS[1] * threshold
+    if not rebound and not ambiguous:
+        return NEW_FRUIT
+    return Verdict(rebound, best["parent"] if rebound else None, ambiguous,
+                   best["speed_ratio"] if rebound else None, best)
