@@ -178,7 +178,7 @@ class LineAnalyzer:
         report.update(rebound=rebound, rebound_of=verdict.parent if rebound else None,
                       rebound_ambiguous=bool(verdict is not None and verdict.ambiguous),
                       rebound_evidence=verdict.evidence if verdict is not None else None)
-        if analysis.fit and shape is not None:
+        if analysis.fit and shape is not None and status != "overlap":
             result = _restated(shape, analysis, speed)
             _merge_fit(report, result)
             if not result.get("converged") and status == "ok":

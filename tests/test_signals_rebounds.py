@@ -1,0 +1,230 @@
+"""Rebound or new fruit, and fruit that land together (issue 13, items 1 and 2).
+
+Independent reference for the rules of item 1: the exact engine's characteristics (``powerlaw_characteristics``,
+itself checked against SciPy in tests/test_engine_powerlaw.py) of one fruit (m, K, c) at its impact speed V and
+of the same fruit at its exit speed e V: what a rebound *is*.  A rebound lands after the flight 2 e V/g of a
+body leaving at e V (no drag).  Each test states the physical fact it checks and why its margin is what it is.
+
+Item 2 is checked on signals built from the exact pulses (``powerlaw_curves``) with 1 % white noise: two fruit a
+few milliseconds apart are two contacts measured each on its own samples; two fruit in one contact are one
+report with status "overlap" and no firmness, never one fruit fitted through both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fruitimpact.constants import STANDARD_GRAVITY as G
+from fruitimpact.engine.codes import RESTITUTION
+from fruitimpact.engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
+from fruitimpact.signals.analysis import Analysis
+from fruitimpact.signals.detect import detect
+from fruitimpact.signals.rebounds import TOLERANCES, from_indices, judge, refine
+
+RATE = 20_000.0
+MASS, DIAMETER, POISSON, MODULUS = 0.19, 0.075, 0.35, 3.5e6
+STIFFNESS = 4 / 3 * MODULUS / (1 - POISSON ** 2) * math.sqrt(DIAMETER / 2)
+V_LINE = math.sqrt(2 * G * 0.05)
+
+
+def impact(mass=MASS, stiffness=STIFFNESS, c=None, velocity=V_LINE, restitution=0.577):
+    """The exact characteristics of one impact: F_max, t_c, T, e, impulse m (1 + e) V, and its c."""
+    c = float(exact_x(restitution)) / V_LINE if c is None else c
+    row = powerlaw_characteristics(mass, stiffness, c, velocity, DIAMETER / 2)[0]
+    e = row[RESTITUTION]
+    return {"F": row[0], "tc": row[1], "T": row[2], "e": e, "impulse": mass * velocity * (1 + e), "c": c,
+            "V": velocity, "m": mass, "K": stiffness}
+
+
+def summary(imp, onset, sequence, velocity=None):
+    """What the analysis knows of a contact: the raw indices, refined by the shape fit (its x, e and end; e to
+    ±0.006, the fit's standard error at 1 % noise: tests/test_signals_fit.py)."""
+    report = {"start_time": onset, "peak_force": imp["F"], "time_to_peak": imp["tc"], "impulse": imp["impulse"]}
+    fit = {"converged": True, "restitution": imp["e"], "restitution_stderr": 0.006, "damping_factor": imp["c"],
+           "velocity": imp["V"], "start_time": onset, "contact_duration": imp["T"]}
+    return refine(from_indices(report, sequence, 0.01 * imp["F"], velocity), fit)
+
+
+def fruit_and_rebound(flight_factor=1.0, speed_factor=1.0, stiffness_factor=1.0):
+    """A fruit at the line's speed and the same fruit (same m and c) coming back at e V × speed_factor after
+    the flight 2 e V/g × flight_factor."""
+    first = impact()
+    second = impact(c=first["c"], velocity=first["e"] * V_LINE * speed_factor,
+                    stiffness=STIFFNESS * stiffness_factor)
+    flight = 2 * first["e"] * V_LINE / G * flight_factor
+    parent = summary(first, 0.1, 0, V_LINE)
+    candidate = summary(second, parent.separation + flight, 1)
+    return parent, candidate, first, second
+
+
+def test_the_same_fruit_at_its_exit_speed_after_its_flight_is_its_rebound():
+    """The defining case: same m, K, c at e V after 2 e V/g.  The speed ratio recovered from the impulses is e
+    (to the shape table's interpolation, 1e-4), every deviation is far inside its tolerance."""
+    parent, candidate, first, _ = fruit_and_rebound()
+    verdict = judge(candidate, [parent], max_flight=1.0)
+    assert verdict.rebound and verdict.parent == 0 and not verdict.ambiguous
+    assert verdict.speed_ratio == pytest.approx(first["e"], rel=1e-4)
+    assert verdict.evidence["flight_predicted"] == pytest.approx(verdict.evidence["flight_observed"], rel=1e-3)
+    assert verdict.evidence["peak_predicted"] == pytest.approx(candidate.peak_force, rel=1e-3)
+    assert verdict.evidence["score"] < 0.05
+
+
+@pytest.mark.parametrize("factor", [0.85, 1.15])
+def test_a_flight_perturbed_by_spin_within_its_tolerance_is_still_a_rebound(factor):
+    """A spinning or off-axis fruit's flight is off by ±10–20 %: within the ±25 % flight tolerance."""
+    parent, candidate, _, _ = fruit_and_rebound(flight_factor=factor)
+    assert judge(candidate, [parent], max_flight=1.0).rebound
+
+
+@pytest.mark.parametrize("factor", [0.6, 1.6])
+def test_a_contact_far_from_the_predicted_flight_is_a_new_fruit(factor):
+    """The same pulse arriving 40 % early or 60 % late is not what the fruit would do: a new fruit (the flight
+    test is |ln(observed/predicted)| / ln-tolerance 0.25, so 0.51 and 0.47 are 2× beyond)."""
+    parent, candidate, _, _ = fruit_and_rebound(flight_factor=factor)
+    verdict = judge(candidate, [parent], max_flight=1.0)
+    assert not verdict.rebound
+
+
+def test_without_the_impact_speed_the_flight_is_not_predicted_but_the_pulse_still_decides():
+    """No drop height: the flight cannot be predicted; the pulse of the same fruit at e V still identifies it."""
+    parent, candidate, _, _ = fruit_and_rebound(flight_factor=1.6)
+    unknown = parent.with_velocity(None)
+    verdict = judge(candidate, [unknown], max_flight=1.0)
+    assert verdict.rebound and verdict.evidence["flight_predicted"] is None
+
+
+def test_a_fruit_cannot_come_back_faster_than_it_left():
+    """Energy: the exit speed is e V, so a 'rebound' at 1.3 e V (which would need e > its own) is a new fruit,
+    though its pulse is the same fruit's at that speed and its flight is 2 (1.3 e V)/g."""
+    first = impact()
+    faster = impact(c=first["c"], velocity=1.3 * first["e"] * V_LINE)
+    parent = summary(first, 0.1, 0, V_LINE)
+    candidate = summary(faster, parent.separation + 2 * 1.3 * first["e"] * V_LINE / G, 1)
+    verdict = judge(candidate, [parent], max_flight=1.0)
+    assert not verdict.rebound
+    assert verdict.evidence is None or verdict.evidence["deviations"]["speed_ratio"] > 1.0
+
+
+def test_a_smaller_fruit_arriving_when_the_rebound_would_is_a_new_fruit():
+    """The old rule's failure ("smaller and soon"): a fruit of 0.6 the mass at the line's speed, landing exactly
+    when the rebound would.  Its impulse gives r ≈ 0.6 ≈ e, but the same fruit at 0.6 V would peak at
+    0.6^1.2 F and take 0.6^-0.2 t_c; this one peaks at 0.6^0.6 F (F ∝ m^0.6) in 0.6^0.4 t_c (t_c ∝ m^0.4):
+    27 % and 24 % off, against tolerances of ~12 %."""
+    first = impact()
+    small = impact(mass=0.6 * MASS, c=first["c"])
+    parent = summary(first, 0.1, 0, V_LINE)
+    candidate = summary(small, parent.separation + 2 * first["e"] * V_LINE / G, 1)
+    verdict = judge(candidate, [parent], max_flight=1.0)
+    assert small["F"] < first["F"] and not verdict.rebound
+
+
+def test_a_rebound_landing_on_a_stiffer_spot_is_still_a_rebound():
+    """The rebound lands on another spot of the fruit: local K ±5 % moves F_max and t_c by ±2 % (K^±0.4),
+    inside the 4 % spot allowance."""
+    parent, candidate, _, _ = fruit_and_rebound(stiffness_factor=1.05)
+    assert judge(candidate, [parent], max_flight=1.0).rebound
+
+
+def test_the_rebound_of_an_earlier_fruit_landing_after_the_next_fruit_finds_its_own_parent():
+    """On a fast feed the next fruit lands before the previous one's rebound: the parent is the earlier fruit
+    whose physics the rebound matches, not the contact just before it."""
+    parent, candidate, first, _ = fruit_and_rebound()
+    other = impact(mass=0.8 * MASS, restitution=0.5)
+    between = summary(other, (parent.onset + candidate.onset) / 2, 1, V_LINE)
+    candidate = summary(impact(c=first["c"], velocity=first["e"] * V_LINE), candidate.onset, 2)
+    verdict = judge(candidate, [parent, between], max_flight=1.0)
+    assert verdict.rebound and verdict.parent == 0
+
+
+def test_a_contact_rebounds_once():
+    """A contact that already has its rebound cannot have a second one: the second candidate is a new fruit
+    (or the rebound's rebound, which has the first rebound as parent)."""
+    parent, candidate, _, _ = fruit_and_rebound()
+    verdict = judge(candidate, [parent.taken()], max_flight=1.0)
+    assert not verdict.rebound
+
+
+def test_the_feed_prior_moves_the_threshold_and_near_decisions_carry_their_evidence():
+    """A borderline case (the flight 32 % long: score 1.1 on the flight test alone) is a new fruit but
+    ambiguous, with the evidence; on the feed's pitch grid it is a clear new fruit (threshold 0.8), off the grid
+    a rebound (threshold 1.25)."""
+    parent, candidate, _, _ = fruit_and_rebound(flight_factor=1.32)
+    plain = judge(candidate, [parent], max_flight=1.0)
+    assert not plain.rebound and plain.ambiguous
+    for key in ("flight_observed", "flight_predicted", "peak_observed", "peak_predicted", "speed_ratio", "score"):
+        assert key in plain.evidence
+    on_grid = judge(candidate, [parent], max_flight=1.0, last_fruit_onset=candidate.onset - 0.1, pitch=0.1)
+    assert not on_grid.rebound and not on_grid.ambiguous
+    off_grid = judge(candidate, [parent], max_flight=1.0, last_fruit_onset=candidate.onset - 0.05, pitch=0.1)
+    assert off_grid.rebound and off_grid.ambiguous
+    assert TOLERANCES["flight"] == 0.25
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Item 2: fruit that land close together or together
+
+
+def _signal(onsets, impacts, n, seed=3):
+    x = np.zeros(n)
+    t = np.arange(n) / RATE
+    for onset, imp in zip(onsets, impacts):
+        inside = (t > onset) & (t < onset + imp["T"])
+        x[inside] += powerlaw_curves(imp["m"], imp["K"], imp["c"], imp["V"], t[inside] - onset)[2]
+    return x + np.random.default_rng(seed).normal(0, 0.01 * impacts[0]["F"], n)
+
+
+def _reports(x, **analysis):
+    analyzer = Analysis(RATE, fit=True, velocity=V_LINE, **analysis).analyzer()
+    return [analyzer.report(i) for i in detect(x, RATE)]
+
+
+def test_fruit_a_few_ms_apart_are_two_contacts_each_measured_on_its_own_samples():
+    """A second, larger fruit 3 ms after the first contact ends: two reports, both ok, neither a rebound, each
+    peak within 1 % and each fitted stiffness within 3 % of its own fruit (the second's rise is cut from the
+    first's window and the first's tail from the second's)."""
+    a = impact()
+    b = impact(mass=1.2 * MASS, restitution=0.5)
+    x = _signal([0.1, 0.1 + a["T"] + 0.003], [a, b], 6000)
+    first, second = _reports(x)
+    for report, imp in ((first, a), (second, b)):
+        assert report["status"] == "ok" and not report["rebound"], report["message"]
+        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.01)
+        assert report["stiffness"] == pytest.approx(imp["K"], rel=0.03)
+
+
+def test_a_fruit_landing_during_another_contact_is_an_overlap_without_firmness():
+    """A second fruit landing 60 % into the first contact (after its peak): the force falls and rises again.
+    One report, status "overlap", no firmness, no class; never one fruit fitted through both."""
+    from fruitimpact.signals.sort import FirmnessClasses
+
+    a = impact()
+    b = impact(mass=0.9 * MASS)
+    x = _signal([0.1, 0.1 + 0.6 * a["T"]], [a, b], 6000)
+    classes = FirmnessClasses("stiffness", (STIFFNESS,), ("soft", "firm"))
+    (report,) = _reports(x, classes=classes)
+    assert report["status"] == "overlap" and "two pulses" in report["message"]
+    assert math.isnan(report["firmness_c"]) and math.isnan(report["firmness_c_star"])
+    assert report["class"] is None and "stiffness" not in report
+    assert report["contact_duration"] > a["T"]  # the contact as detected: both pulses
+
+
+def test_two_fruit_landing_together_are_flagged_by_their_misfit():
+    """Two fruit touching 1.5 ms apart make one unimodal pulse (no dip), but no single fruit's force law
+    fits it: the fit's residual is several noise sd, above the 1.6 one fruit leaves (analysis.RESIDUAL_LIMIT)."""
+    a = impact()
+    b = impact(mass=0.7 * MASS)
+    x = _signal([0.1, 0.1015], [a, b], 6000)
+    (report,) = _reports(x)
+    assert report["status"] == "overlap" and "not one pulse" in report["message"]
+    assert math.isnan(report["firmness_c"])
+
+
+def test_one_fruit_alone_is_never_an_overlap():
+    """The same fruit alone at 1 % noise, 20 seeds: status ok every time (its residual is the noise)."""
+    a = impact()
+    for seed in range(20):
+        (report,) = _reports(_signal([0.1], [a], 4000, seed=seed))
+        assert report["status"] == "ok", report["message"]
