@@ -213,7 +213,8 @@ def test_a_fruit_landing_during_another_contact_is_an_overlap_without_firmness()
 
 def test_two_fruit_landing_together_are_flagged_by_their_misfit():
     """Two fruit touching 1.5 ms apart make one unimodal pulse (no dip), but no single fruit's force law
-    fits it: the fit's residual is several noise sd, above the 1.6 one fruit leaves (analysis.RESIDUAL_LIMIT)."""
+    fits it: the fit misses it by several % of the peak beyond the noise, above the 1.8 % (analysis.MISFIT_LIMIT)
+    that one fruit with ringing and hum stays under."""
     a = impact()
     b = impact(mass=0.7 * MASS)
     x = _signal([0.1, 0.1015], [a, b], 6000)
