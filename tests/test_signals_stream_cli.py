@@ -18,13 +18,23 @@ def _reports(text: str) -> list[dict]:
     return sorted(rows, key=lambda r: (r["start_time"], r["lane"]))
 
 
-def test_stream_in_random_chunks_equals_analyze(cli, tmp_path):
+def test_stream_in_random_chunks_equals_analyze(cli, tmp_path, monkeypatch):
+    """analyze reads the file in chunks (here of 7,919 samples, cutting contacts apart) through the same
+    detector and analysis as stream: the same JSON objects, whatever the chunk and read sizes."""
+    from fruitimpact.cli import signals as signals_cli
+
     recording = tmp_path / "line.f32"
     cli.ok("synth", "-o", recording, "--count", "12", "--lanes", "2", "--seed", "5")
+    monkeypatch.setattr(signals_cli, "ANALYZE_CHUNK", 7919)
     status, out, err = cli.run("analyze", recording, "--rate", "20000", "--lanes", "2", "--fit", "--drop-height",
                                "5cm", "--json")
     assert status == 0, err
     expected = _reports(out)
+    monkeypatch.setattr(signals_cli, "ANALYZE_CHUNK", 1 << 18)
+    status, whole, err = cli.run("analyze", recording, "--rate", "20000", "--lanes", "2", "--fit", "--drop-height",
+                                 "5cm", "--json")
+    assert status == 0, err
+    assert _reports(whole) == expected  # one chunk or 16: the same
     assert len(expected) >= 24
     data = recording.read_bytes()
     # a writer that sends the bytes in random pieces (cutting samples and lanes apart), flushing each
@@ -63,3 +73,15 @@ def test_stream_refuses_bad_options_in_one_line(cli):
     assert "--format" in cli.error("stream", "--rate", "20000", "--format", "csv")
     assert "--listen" in cli.error("stream", "--rate", "20000", "--listen", "70000")
     assert "exactly one of" in cli.error("stream", "--rate", "20000", "--fit")
+
+
+def test_raw_float32_fed_as_text_is_refused_early_in_one_line():
+    """Issue 13 item 7: float32 bytes without --format f32 end with one clear line (exit 2) after the first few
+    hundred 'lines', not a warning after reading everything; --json is accepted as for analyze."""
+    samples = np.random.default_rng(2).normal(0.0, 0.5, 400_000).astype("<f4").tobytes()
+    result = subprocess.run([console_script(), "stream", "--rate", "20000", "--json"], input=samples,
+                            capture_output=True, timeout=120)
+    err = result.stderr.decode()
+    assert result.returncode == 2, err
+    assert "looks like binary" in err and "--format f32" in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

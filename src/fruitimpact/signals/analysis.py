@@ -160,10 +160,14 @@ class LineAnalyzer:
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
                            f"(one fruit: at most {MISFIT_LIMIT:.1%}): two fruit landing together; no firmness")
-        if status == "overlap":
+        if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
-            report["contact_duration"] = (impact.end_index + 1 - impact.start_index) / analysis.rate
+            inside = own.window[impact.start_index - own.window_start:impact.end_index + 1 - own.window_start]
+            report.update(start_time=impact.start_index / analysis.rate,
+                          time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
+                          contact_duration=(impact.end_index + 1 - impact.start_index) / analysis.rate,
+                          impulse=float(np.sum(inside)) / analysis.rate)
         # what the rebound test knows of this contact (its impact speed is set once decided)
         summary = None
         if status in ("ok", "clipped"):
