@@ -1,24 +1,31 @@
-"""Reading force recordings (issue 8, item 1): ``Recording`` and ``signals.read_recording``.
+"""Reading force recordings (issue 8, item 1; issue 13, item 4): ``Recording``, ``signals.read_recording``
+and ``signals.read.open_recording`` (the same reading, chunk by chunk, in memory bounded by the chunk).
 
 References: files written here by hand (CSV text, ``numpy.save``, raw bytes
-from ``numpy.tofile``, ``nptdms.TdmsWriter``) with values chosen in the test,
-and the example TDMS files that ship inside the nptdms wheel
-(``nptdms/test/data``, written by LabVIEW / DAQmx), whose expected values are
-those asserted by npTDMS's own tests (``nptdms/test/test_example_files.py``).
-Round trips go through ``signals.synth.write_recording``; CSV floats are written
-as shortest round-trip decimals, so they read back bit-identical; float32
-files read back as the float32 rounding of the values, exactly.
+from ``numpy.tofile``, ``nptdms.TdmsWriter``, TDMS segments written byte by byte
+from the file format) with values chosen in the test, and the example TDMS files
+that ship inside the nptdms wheel (``nptdms/test/data``, written by LabVIEW /
+DAQmx), whose expected values are those asserted by npTDMS's own tests
+(``nptdms/test/test_example_files.py``) or read by nptdms itself
+(``TdmsFile.read``).  Round trips go through ``signals.synth.write_recording``;
+CSV floats are written as shortest round-trip decimals, so they read back
+bit-identical; float32 files read back as the float32 rounding of the values,
+exactly.  Chunked reading is held to ``read_recording`` bit for bit, for every
+chunk size.
 """
 
 from __future__ import annotations
 
 import importlib.resources
 import math
+import struct
+import tracemalloc
 
 import numpy as np
 import pytest
 
 from fruitimpact.signals import Recording, read_recording, write_recording
+from fruitimpact.signals.read import RecordingSource, csvtable, open_recording
 
 RNG = np.random.default_rng(8)
 
@@ -431,3 +438,393 @@ def test_tdms_garbage_and_empty(tmp_path):
     (tmp_path / "g.tdms").write_bytes(bytes(range(200)))
     _refused(r"not a readable TDMS file", tmp_path / "g.tdms")
     _refused(r"no channels", _tdms(tmp_path / "n.tdms", []))
+
+
+# --------------------------------------------------------------------------- chunk by chunk (issue 13, item 4)
+
+def _matrix(rec: Recording) -> np.ndarray:
+    return np.column_stack([rec.lanes[name] for name in rec.lane_names])
+
+
+def _joined(source: RecordingSource, samples: int) -> np.ndarray:
+    """Every chunk of ``source`` checked for shape, dtype and layout, joined."""
+    chunks = list(source.chunks(samples))
+    for k, chunk in enumerate(chunks):
+        assert chunk.dtype == np.float64 and chunk.flags.c_contiguous and chunk.ndim == 2
+        assert chunk.shape[1] == len(source.lane_names)
+        assert chunk.shape[0] == samples if k < len(chunks) - 1 else 1 <= chunk.shape[0] <= samples
+    return np.concatenate(chunks)
+
+
+def _same_as_read(path, sizes, **kwargs):
+    """Chunks of every size in ``sizes`` join to exactly what read_recording returns, metadata alike."""
+    rec = read_recording(path, **kwargs)
+    source = open_recording(path, **kwargs)
+    assert (source.rate, source.lane_names, source.start_time, source.clip_low, source.clip_high, source.source) == \
+        (rec.rate, rec.lane_names, rec.start_time, rec.clip_low, rec.clip_high, rec.source)
+    assert source.samples in (None, rec.samples)
+    for size in sizes:
+        np.testing.assert_array_equal(_joined(source, size), _matrix(rec), err_msg=f"chunks of {size}")
+    return rec, source
+
+
+FORMAT_CASES = [("csv", {}), ("npy", {"rate": 20000.0}), ("f32", {"rate": 20000.0, "lanes": 3}), ("tdms", {})]
+
+
+@pytest.mark.parametrize("suffix,kwargs", FORMAT_CASES)
+def test_chunks_of_any_size_join_to_read_recording(tmp_path, suffix, kwargs):
+    rec = _recording(lanes=3, samples=5000, clip_low=-99.0, clip_high=99.0)
+    path = write_recording(rec, tmp_path / f"r.{suffix}")
+    got, source = _same_as_read(path, [1, 2, 7, 4096, 5000, 5001, 1 << 20], **kwargs)
+    np.testing.assert_array_equal(got.lanes[got.lane_names[2]], rec.lanes["force2"].astype(
+        np.float32 if suffix == "f32" else np.float64))
+    assert source.samples == 5000 and source.duration == pytest.approx(0.25)
+    assert source.format == suffix
+    # one lane of several
+    column = {"csv": "force1", "npy": "lane1", "f32": "lane1", "tdms": "force1"}[suffix]
+    one, _ = _same_as_read(path, [1, 333], column=column, **kwargs)
+    assert one.samples == 5000 and len(one.lane_names) == 1
+
+
+def test_chunks_restart_and_refuse_a_bad_size(tmp_path):
+    path = write_recording(_recording(lanes=2, samples=300), tmp_path / "r.npy")
+    source = open_recording(path, rate=1000.0)
+    first, second = _joined(source, 64), _joined(source, 64)
+    np.testing.assert_array_equal(first, second)  # each call reads the file again
+    for bad in (0, -1, 2.5, True, "64"):
+        with pytest.raises(ValueError, match=r"samples must be an integer >= 1 \(samples per lane in a chunk\)"):
+            source.chunks(bad)
+    with pytest.raises(AttributeError):
+        source.rate = 5.0  # frozen
+    assert "RecordingSource(source=" in repr(source) and "lane_names=('lane0', 'lane1')" in repr(source)
+
+
+def test_fortran_order_and_big_endian_npy(tmp_path):
+    values = RNG.normal(0.0, 1.0, (3000, 3))
+    np.save(tmp_path / "f.npy", np.asfortranarray(values))
+    np.save(tmp_path / "b.npy", values.astype(">f8"))
+    np.save(tmp_path / "i.npy", (values * 1000).astype(">i4"))
+    for name in ("f.npy", "b.npy", "i.npy"):
+        rec, _ = _same_as_read(tmp_path / name, [1, 1000, 4096], rate=100.0)
+        expected = np.load(tmp_path / name).astype(np.float64)
+        np.testing.assert_array_equal(_matrix(rec), expected)
+    _same_as_read(tmp_path / "f.npy", [5, 3000], rate=100.0, column="lane2")
+
+
+# ----------------------------------------------------------------- CSV blocks cut anywhere
+
+CSV_TRICKY = ("\ufeff# exported by a test\n\ntime [ms];left [kN];right\r\n" + "".join(
+    (f"# pause {i}\n\n" if i % 37 == 5 else "") + f"{10 + i * 0.05:.2f};{i * 1e-3:.3f};{(-1) ** i * i}\r\n"
+    for i in range(900)))
+
+
+@pytest.mark.parametrize("block", [1, 17, 333, 4096])
+@pytest.mark.parametrize("rate_rows", [2, 3, 100, 1 << 16])
+def test_csv_blocks_cutting_rows_comments_and_time_checks(tmp_path, monkeypatch, block, rate_rows):
+    # milliseconds written with 2 decimals: intervals 0.05 ms exact to 1e-6 relative
+    path = _write(tmp_path / "a.csv", CSV_TRICKY)
+    reference = read_recording(path)
+    assert reference.samples == 900 and reference.lane_names == ("left", "right")
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", block)
+    monkeypatch.setattr(csvtable, "RATE_ROWS", rate_rows)
+    source = open_recording(path)
+    assert source.rate == pytest.approx(20000.0, rel=1e-9) and source.start_time == pytest.approx(0.010)
+    assert source.samples == (900 if rate_rows > 900 else None)
+    for size in (1, 7, 1000) if block > 100 else (7,):
+        np.testing.assert_array_equal(_joined(source, size), _matrix(reference))
+
+
+def test_csv_rate_comes_from_the_first_rows(tmp_path, monkeypatch):
+    # the first RATE_ROWS rows give the rate; every later interval is held to it
+    monkeypatch.setattr(csvtable, "RATE_ROWS", 4)
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", 16)
+    path = _write(tmp_path / "a.csv", "time [s],f\n" + "".join(f"{i / 8},{i}\n" for i in range(40)))
+    source = open_recording(path)
+    assert source.rate == 8.0 and source.samples is None
+    np.testing.assert_array_equal(_joined(source, 3)[:, 0], np.arange(40.0))
+
+
+def _long_csv(rows, bad_row=None, bad_text=None):
+    lines = ["# long file", "time [s],a [N],b [N]"]
+    for i in range(rows):
+        lines.append(bad_text if i == bad_row else f"{i / 1000:.3f},{i},{-i}")
+        if i % 100 == 50:
+            lines.append("# a comment between rows")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("bad_text,match", [
+    ("1.5,1,x", r"line {line} \(data row {row}\), column 'b \[N\]': 'x' is not a number"),
+    ("1.5,1,nan", r"line {line} \(data row {row}\), column 'b \[N\]': 'nan' is not a number"),
+    ("1.5,1,", r"line {line} \(data row {row}\), column 'b \[N\]': empty cell"),
+    ("1.5,1", r"line {line} has 2 cells, the header 3 \(ragged row\)"),
+    ("1.5,1,2,3", r"line {line} has 4 cells, the header 3 \(ragged row\)"),
+    ("1.498,1,2", r"non-monotonic time at row {row} \(line {line}\): 1.498 s after 1.499 s"),
+    ("1.5000002,1,2", r"non-uniform sampling at row {row} \(line {line}\): interval 0.0010002 s"),
+])
+def test_csv_errors_mid_file_name_their_line(tmp_path, monkeypatch, bad_text, match):
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", 2000)
+    monkeypatch.setattr(csvtable, "RATE_ROWS", 200)
+    bad_row = 1500
+    path = _write(tmp_path / "long.csv", _long_csv(2000, bad_row, bad_text))
+    line = 3 + bad_row + (bad_row - 51) // 100 + 1  # two lines before the rows, one comment per 100 rows
+    assert path.read_text().splitlines()[line - 1] == bad_text
+    source = open_recording(path)  # the first rows are fine: the file opens
+    assert source.samples is None and source.rate == pytest.approx(1000.0, rel=1e-9)
+    seen = 0
+    with pytest.raises(ValueError, match=match.format(line=line, row=bad_row + 1)) as info:
+        for chunk in source.chunks(100):
+            seen += chunk.shape[0]
+    assert "\n" not in str(info.value) and "long.csv" in str(info.value)
+    assert 1000 <= seen <= bad_row  # the chunks before the bad block came out first
+    with pytest.raises(ValueError, match=match.format(line=line, row=bad_row + 1)):
+        read_recording(path)
+
+
+def test_csv_error_in_the_first_rows_is_refused_by_open(tmp_path):
+    path = _write(tmp_path / "a.csv", _long_csv(100, 30, "0.030,1,oops"))
+    with pytest.raises(ValueError, match=r"line 33 \(data row 31\), column 'b \[N\]': 'oops' is not a number"):
+        open_recording(path)
+
+
+def test_csv_undecodable_byte_offset_in_a_later_block(tmp_path, monkeypatch):
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", 64)
+    text = _long_csv(300).encode()
+    position = text.index(b"0.250,250")
+    path = tmp_path / "a.csv"
+    path.write_bytes(text[:position] + b"\xff" + text[position + 1:])
+    with pytest.raises(ValueError, match=rf"not UTF-8 text \(undecodable byte at offset {position}\)"):
+        read_recording(path)
+    path.write_bytes(text[:position] + b"\x00" + text[position + 1:])
+    with pytest.raises(ValueError, match=r"binary content \(NUL bytes\), not CSV text"):
+        read_recording(path)
+
+
+def test_csv_header_after_a_long_preamble(tmp_path, monkeypatch):
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", 8)
+    path = _write(tmp_path / "a.csv", "# " + "x" * 100 + "\n\n  \n# more\nforce [kN]\n1\n2\n")
+    rec, source = _same_as_read(path, [1, 2], rate=10.0)
+    np.testing.assert_array_equal(rec.lanes["force"], [1000.0, 2000.0])
+    _write(tmp_path / "e.csv", "\n  \n\t\n")
+    _refused(r"empty file$", tmp_path / "e.csv")
+
+
+# ----------------------------------------------------------------- binary and TDMS errors mid-file
+
+def test_npy_and_raw_non_finite_mid_file(tmp_path):
+    values = RNG.normal(0.0, 1.0, (200_000, 2))
+    values[150_001, 1] = np.nan
+    np.save(tmp_path / "a.npy", values)
+    values.astype("<f4").tofile(tmp_path / "a.f32")
+    for name, kwargs in (("a.npy", {}), ("a.f32", {"lanes": 2})):
+        source = open_recording(tmp_path / name, rate=1000.0, **kwargs)
+        seen = 0
+        with pytest.raises(ValueError, match=r"sample 150001 of lane 'lane1' is nan; force samples must be finite"):
+            for chunk in source.chunks(1000):
+                seen += chunk.shape[0]
+        assert 100_000 <= seen <= 150_001  # the chunks before the bad block came out first
+        lane0 = open_recording(tmp_path / name, rate=1000.0, column="lane0", **kwargs)  # the other lane is fine
+        np.testing.assert_array_equal(_joined(lane0, 70_000)[:, 0],
+                                      values[:, 0].astype(np.float32 if name.endswith("f32") else np.float64))
+
+
+def test_file_cut_short_after_opening(tmp_path):
+    path = tmp_path / "a.f32"
+    np.arange(400_000, dtype="<f4").tofile(path)
+    source = open_recording(path, rate=10.0)
+    with open(path, "r+b") as handle:
+        handle.truncate(4 * 100_000)
+    with pytest.raises(ValueError, match=r"the file ends at byte 400000, before byte 524288 .*\(truncated, or "
+                                         r"changed since it was opened\)"):
+        list(source.chunks(1000))
+
+
+def test_tdms_non_finite_mid_file(tmp_path):
+    data = np.arange(300_000.0)
+    data[200_000] = np.inf
+    path = _tdms(tmp_path / "a.tdms", [("a", data, {"wf_increment": 1e-4})])
+    source = open_recording(path)
+    with pytest.raises(ValueError, match=r"sample 200000 of lane 'daq/a' is inf"):
+        list(source.chunks(4096))
+
+
+# ----------------------------------------------------------------- TDMS, read as nptdms reads it
+
+def _nptdms_values(path, names):
+    from nptdms import TdmsFile
+
+    tdms = TdmsFile.read(path)
+    channels = {f"{group.name}/{channel.name}": channel for group in tdms.groups() for channel in group.channels()}
+    return np.column_stack([np.asarray(channels[name][:], dtype=np.float64) for name in names])
+
+
+@pytest.mark.parametrize("name,kwargs", [
+    ("big_endian.tdms", {}),                   # big-endian, two segments, the second of 6 raw-data chunks
+    ("raw_timestamps.tdms", {}),
+    ("Digital_Input.tdms", {"column": "07/09/2012 06:58:23 PM - Digital Input - All Data/Dev1_port3_line7 - line 0"}),
+    ("Digital_Input.tdms", {"column": "07/09/2012 06:58:23 PM - Digital Input - Decimated Data_Level1/"
+                                      "Dev1_port3_line7 - line 0"}),
+])
+def test_nptdms_examples_chunked_as_nptdms_reads_them(name, kwargs):
+    path = _example(name)
+    rec, source = _same_as_read(path, [1, 3, 500, 1 << 16], **kwargs)
+    np.testing.assert_array_equal(_matrix(rec), _nptdms_values(path, rec.lane_names))
+
+
+def test_nptdms_daqmx_example_with_scaling(tmp_path):
+    # raw1.tdms: DAQmx raw data (int16 words) with linear scaling to Volts; its unit renamed to newtons
+    # (the same length, so every offset stays) to read it as force: the scaled values, as nptdms scales them
+    raw = _example("raw1.tdms").read_bytes()
+    assert raw.count(b"\x05\x00\x00\x00Volts") >= 2
+    path = tmp_path / "raw1_newtons.tdms"
+    path.write_bytes(raw.replace(b"\x05\x00\x00\x00Volts", b"\x05\x00\x00\x00N    "))
+    rec, source = _same_as_read(path, [1, 77, 2000])
+    assert rec.samples == 2000 and len(rec.lane_names) >= 2
+    np.testing.assert_array_equal(_matrix(rec), _nptdms_values(path, rec.lane_names))
+    assert np.ptp(_matrix(rec)) > 0.0
+
+
+def _tdms_segment(channels, chunks=1, interleaved=False, big=False) -> bytes:
+    """One TDMS segment written byte by byte from the format: the lead-in ("TDSm", table of contents,
+    version 4713, offsets of the next segment and of the raw data), the metadata (objects with their
+    raw-data index: type, dimension 1, values per chunk) and the raw data, ``chunks`` chunks of every
+    channel in turn, or rows of one value of every channel (``interleaved``)."""
+    order = ">" if big else "<"
+    codes = {"i2": 2, "i4": 3, "f4": 9, "f8": 10}
+
+    def string(text):
+        data = text.encode()
+        return struct.pack(order + "L", len(data)) + data
+
+    objects = [("/", None), ("/'daq'", None)] + [(f"/'daq'/'{name}'", values) for name, values in channels]
+    meta = struct.pack(order + "L", len(objects))
+    for name, values in objects:
+        meta += string(name)
+        if values is None:
+            meta += struct.pack(order + "L", 0xFFFFFFFF)
+        else:
+            meta += struct.pack(order + "LLLQ", 20, codes[values.dtype.str[1:]], 1, values.size // chunks)
+        meta += struct.pack(order + "L", 0)
+    if interleaved:
+        rows = np.empty(channels[0][1].size, dtype=[(name, values.dtype.newbyteorder(order))
+                                                    for name, values in channels])
+        for name, values in channels:
+            rows[name] = values
+        data = rows.tobytes()
+    else:
+        data = b"".join(values.reshape(chunks, -1)[k].astype(values.dtype.newbyteorder(order)).tobytes()
+                        for k in range(chunks) for _, values in channels)
+    toc = (1 << 1) | (1 << 2) | (1 << 3) | ((1 << 5) if interleaved else 0) | ((1 << 6) if big else 0)
+    return b"TDSm" + struct.pack("<l", toc) + struct.pack(order + "lQQ", 4713, len(meta) + len(data), len(meta)) \
+        + meta + data
+
+
+def test_tdms_segments_contiguous_interleaved_chunked_big_endian_and_cut_short(tmp_path):
+    x = np.arange(6000)
+    segments = [
+        _tdms_segment([("a", (x[:1200] * 0.5).astype("f8")), ("b", x[:1200].astype("i4"))], chunks=3),
+        _tdms_segment([("a", (x[1200:3000] * 0.5).astype("f8")), ("b", x[1200:3000].astype("i4"))],
+                      interleaved=True, big=True),
+        _tdms_segment([("a", (x[3000:4000] * 0.5).astype("f8")), ("b", x[3000:4000].astype("i4"))], chunks=4,
+                      big=True),
+        _tdms_segment([("a", (x[4000:6000] * 0.5).astype("f8")), ("b", x[4000:6000].astype("i4"))],
+                      interleaved=True),
+    ]
+    path = tmp_path / "hand.tdms"
+    path.write_bytes(b"".join(segments))
+    rec, source = _same_as_read(path, [1, 999, 1000, 4096], rate=1000.0)
+    assert rec.lane_names == ("daq/a", "daq/b") and rec.samples == 6000
+    np.testing.assert_array_equal(_matrix(rec), np.column_stack([x * 0.5, x]))
+    np.testing.assert_array_equal(_matrix(rec), _nptdms_values(path, rec.lane_names))
+    # a recording cut in its last (interleaved, 12-byte rows) segment: the whole rows are read, as nptdms does
+    path.write_bytes(b"".join(segments)[:-12 * 700 - 5])
+    rec, _ = _same_as_read(path, [1, 4096], rate=1000.0)
+    assert rec.samples == 6000 - 701
+    np.testing.assert_array_equal(_matrix(rec), _nptdms_values(path, rec.lane_names))
+
+
+def test_tdms_mixed_sizes_interleaved(tmp_path):
+    x = np.arange(-500, 500)
+    path = tmp_path / "mixed.tdms"
+    path.write_bytes(_tdms_segment([("s", x.astype("i2")), ("f", (x / 4).astype("f4")), ("d", (x / 8).astype("f8"))],
+                                   interleaved=True, big=True))
+    rec, _ = _same_as_read(path, [1, 3, 1000], rate=50.0)
+    np.testing.assert_array_equal(_matrix(rec), np.column_stack([x, x / 4, x / 8]))
+    one, _ = _same_as_read(path, [1, 64], rate=50.0, column="f")
+    np.testing.assert_array_equal(one.lanes["daq/f"], x / 4)
+
+
+def test_tdms_many_segments_written_by_nptdms(tmp_path):
+    from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
+
+    x = RNG.normal(0.0, 1.0, (3, 5000))
+    properties = {"wf_increment": 1e-4, "unit_string": "kN"}
+    with TdmsWriter(str(tmp_path / "many.tdms")) as writer:
+        for k in range(0, 5000, 250):
+            objects = [RootObject({}), GroupObject("daq")] if k == 0 else []
+            writer.write_segment(objects + [ChannelObject("daq", f"c{j}", x[j, k:k + 250], properties=properties)
+                                            for j in range(3)])
+    rec, _ = _same_as_read(tmp_path / "many.tdms", [1, 249, 251, 4096])
+    np.testing.assert_array_equal(_matrix(rec), x.T * 1e3)
+
+
+def test_open_refuses_what_the_header_says(tmp_path):
+    # every check that needs no sample is made by open_recording, before any chunk is asked for
+    csv_path = _write(tmp_path / "a.csv", "time [s],f [V]\n" + "0,1\n" * 10)
+    with pytest.raises(ValueError, match=r"force unit 'V' is not allowed"):
+        open_recording(csv_path)
+    with pytest.raises(ValueError, match=r"unknown column 'x' \(available: 'daq/a'\)"):
+        open_recording(_tdms(tmp_path / "a.tdms", [("a", np.arange(3.0), {})]), column="x", rate=1.0)
+    with pytest.raises(ValueError, match=r"rate is required: raw float32 files hold no time"):
+        open_recording(write_recording(_recording(), tmp_path / "a.f32"))
+    with pytest.raises(ValueError, match=r"rate=30000 Hz disagrees with the time column"):
+        open_recording(write_recording(_recording(), tmp_path / "b.csv"), rate=30000.0)
+    with pytest.raises(ValueError, match=r"lanes must be an integer >= 1"):
+        open_recording(tmp_path / "missing.f32", lanes=0)
+
+
+# ----------------------------------------------------------------- memory bounded by the chunk
+
+def _peak(function) -> int:
+    """Peak of the memory traced by tracemalloc [bytes] while ``function`` runs (numpy's buffers included)."""
+    tracemalloc.start()
+    try:
+        function()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def _write_long(path, suffix, samples):
+    values = np.column_stack([np.sin(np.arange(samples) * 1e-3), np.arange(samples) % 1000 - 500.0])
+    if suffix == "f32":
+        values.astype("<f4").tofile(path)
+    elif suffix == "npy":
+        np.save(path, values)
+    elif suffix == "tdms":
+        _tdms(path, [("a", values[:, 0], {"wf_increment": 1e-4}), ("b", values[:, 1], {"wf_increment": 1e-4})])
+    else:
+        with open(path, "w") as handle:
+            handle.write("time [ms],a,b\n")
+            for start in range(0, samples, 100_000):
+                t = np.arange(start, min(samples, start + 100_000))
+                handle.write("".join(f"{i / 10},{i % 7},{i % 1000 - 500}\n" for i in t))
+
+
+@pytest.mark.parametrize("suffix,samples", [("f32", 1 << 19), ("npy", 1 << 19), ("tdms", 1 << 19), ("csv", 1 << 16)])
+def test_memory_is_bounded_by_the_chunk_not_the_file(tmp_path, monkeypatch, suffix, samples):
+    # two files, one 4x the other; a one-segment TDMS file (its channels of 2^21 values each)
+    monkeypatch.setattr(csvtable, "BLOCK_BYTES", 1 << 16)
+    kwargs = {"rate": 10000.0, "lanes": 2} if suffix == "f32" else {"rate": 10000.0} if suffix == "npy" else {}
+    peaks, full = [], None
+    for n in (samples, 4 * samples):
+        path = tmp_path / f"long{n}.{suffix}"
+        _write_long(path, suffix, n)
+        source = open_recording(path, **kwargs)
+        peaks.append(_peak(lambda: sum(chunk.shape[0] for chunk in source.chunks(4096))))  # noqa: B023
+        assert sum(chunk.shape[0] for chunk in source.chunks(4096)) == n
+        full = _peak(lambda: read_recording(path, **kwargs))  # noqa: B023
+    whole = 4 * samples * 2 * 8  # the float64 samples of the long file [bytes]
+    assert full > whole, (full, whole)  # the instrument sees a file-sized reading
+    assert peaks[1] < 1.2 * peaks[0] + (64 << 10), peaks  # 4x the file, (almost) the same peak
+    assert peaks[1] < whole / 4, (peaks, whole)
