@@ -306,7 +306,7 @@ def _analyse(cli, tmp_path, name):
 #: ``rebound_ambiguous`` (a guess either way would be silent), and two fruit touching within ~1 ms are one
 #: pulse.  Open limitation of issue 13, tracked here: strict, so this list must shrink when it is fixed.
 OPEN = {"chain10": "rebounds of fruit hidden in overlaps (35 % of contacts overlap); fruit landing within ~1 ms",
-        "close": "a rebound of a fruit hidden in an overlap", "noisy": "rebounds of fruit hidden in overlaps"}
+        "noisy": "rebounds of fruit hidden in overlaps"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(name in OPEN, reason=OPEN.get(name, ""),

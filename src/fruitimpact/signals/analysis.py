@@ -126,7 +126,7 @@ class Analysis:
 
 class LineAnalyzer:
     """The state of one stream's analysis: the recent contacts of each lane (``Analysis`` does the rest).
-    ``report(impact)`` must be called for the impacts of a lane in the order the detector emits them."""
+    ``reports(impact)`` must be called for the impacts of a lane in the order the detector emits them."""
 
     def __init__(self, analysis: Analysis):
         self.analysis = analysis
@@ -136,13 +136,15 @@ class LineAnalyzer:
         self._unmeasured: dict[int, list[tuple]] = {}
         #: per lane: restitution of the recent new fruit (the lot's typical e at the line's speed)
         self._fruit_restitution: dict[int, list[float]] = {}
+        #: per lane: the number of the next contact (a detected impact holds one or two contacts)
+        self._sequence: dict[int, int] = {}
 
-    def report(self, impact: DetectedImpact) -> dict:
-        """The dict of one contact (SI); ``public(report)`` is its JSON object."""
+    def reports(self, impact: DetectedImpact) -> list[dict]:
+        """The dicts of the contacts in one detected impact, in time order (SI; ``public(report)`` is the
+        JSON object): one, or two when two fruit in one contact were told apart (``signals.split``)."""
         analysis = self.analysis
         own = isolated(impact)
         report = impact_indices(own, analysis.rate)
-        report["sequence"] = impact.sequence
         status, message = _status(impact)
         peak = report["peak_force"]
         second = second_pulse(own)
@@ -160,6 +162,12 @@ class LineAnalyzer:
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
                            f"(one fruit: at most {MISFIT_LIMIT:.1%}): two fruit landing together; no firmness")
+        if status == "overlap" and not (impact.truncated or impact.overlong or impact.clipped):
+            parts = self._split(own)
+            if parts is not None:
+                return [self._contact(piece, impact_indices(piece, analysis.rate), fit, "ok",
+                                      "one of two fruit in one contact, told apart by a joint fit of two pulses")
+                        for piece, fit in parts]
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
@@ -168,10 +176,45 @@ class LineAnalyzer:
                           time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
                           contact_duration=(impact.end_index + 1 - impact.start_index) / analysis.rate,
                           impulse=float(np.sum(inside)) / analysis.rate)
+        return [self._contact(own, report, shape, status, message)]
+
+    def _split(self, own: DetectedImpact):
+        """Two (piece, fit) of a contact holding two pulses, or None (``signals.split``)."""
+        from .split import split_contact
+
+        analysis = self.analysis
+        time = (own.window_start + np.arange(own.window.size)) / analysis.rate
+        parts = split_contact(time, own.window, own.noise, velocity=1.0 if analysis.mass is None else None,
+                              mass=analysis.mass, diameter=analysis.diameter, poisson=analysis.poisson)
+        if parts is None:
+            return None
+        (fit_a, force_a), (fit_b, force_b) = parts
+        rate, ws = analysis.rate, own.window_start
+        onset_b = min(max(math.ceil(fit_b["start_time"] * rate), own.start_index + 1), own.end_index)
+        end_a = min(max(math.floor((fit_a["start_time"] + fit_a["contact_duration"]) * rate), own.start_index),
+                    own.end_index)
+        pieces = []
+        for force, start, end, fit in ((force_a, own.start_index, end_a, fit_a),
+                                       (force_b, onset_b, own.end_index, fit_b)):
+            window = np.ascontiguousarray(force)
+            window.setflags(write=False)
+            inside = window[start - ws:end + 1 - ws]
+            peak_index = start + int(np.argmax(inside)) if inside.size else start
+            pieces.append((dataclasses.replace(own, window=window, start_index=start, end_index=end,
+                                               peak_index=peak_index, peak_value=float(window[peak_index - ws])),
+                           fit))
+        return pieces
+
+    def _contact(self, impact: DetectedImpact, report: dict, shape: dict | None, status: str, message: str) -> dict:
+        """The rest of a contact's report: the rebound decision, the fit restated, the class."""
+        analysis = self.analysis
+        sequence = self._sequence.get(impact.lane, 0)
+        self._sequence[impact.lane] = sequence + 1
+        report["sequence"] = sequence
         # what the rebound test knows of this contact (its impact speed is set once decided)
         summary = None
         if status in ("ok", "clipped"):
-            summary = from_indices(report, impact.sequence, impact.noise, None)
+            summary = from_indices(report, sequence, impact.noise, None)
             if summary is not None:
                 summary = refine(summary, shape)
         history = self._history.setdefault(impact.lane, [])
@@ -207,7 +250,7 @@ class LineAnalyzer:
             self._last_fruit[impact.lane] = report["start_time"]
         if status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
-            self._unmeasured.setdefault(impact.lane, []).append((impact.sequence, report["start_time"], span_end))
+            self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
         elif summary is not None and not rebound and summary.refined:
             self._fruit_restitution.setdefault(impact.lane, []).append(summary.restitution)
             del self._fruit_restitution[impact.lane][:-15]

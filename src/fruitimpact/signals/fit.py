@@ -338,8 +338,9 @@ def _start(t, y, model: _Model, weights) -> tuple[np.ndarray | None, str]:
 # ---------------------------------------------------------------------------------------------------------
 # Levenberg–Marquardt
 
-def _levenberg_marquardt(model: _Model, y: np.ndarray, theta: np.ndarray, weights):
-    """Minimise Σ (w (F(θ) − y))² over θ = (t0, ln F_max, ln T, x, baseline…) with x projected on [0, X_MAX].
+def _levenberg_marquardt(model: _Model, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,)):
+    """Minimise Σ (w (F(θ) − y))² over θ = (t0, ln F_max, ln T, x, baseline…) with each x (the entries
+    ``bounded``) projected on [0, X_MAX].
     Marquardt's diagonal scaling, Nielsen's damping update.  Returns (θ, J at θ, residual, iterations,
     converged, message)."""
 
@@ -379,7 +380,8 @@ def _levenberg_marquardt(model: _Model, y: np.ndarray, theta: np.ndarray, weight
                     return theta, jac, r, iterations, False, "the normal equations are singular"
                 continue
             trial = theta + step
-            trial[3] = min(max(trial[3], 0.0), X_MAX)
+            for k in bounded:
+                trial[k] = min(max(trial[k], 0.0), X_MAX)
             step = trial - theta
             r_trial = evaluate(trial)
             cost_trial = float(r_trial @ r_trial)

@@ -353,18 +353,20 @@ class StreamAnalyzer:
         return count + self._emit(self.detector.flush())
 
     def _emit(self, impacts: list[DetectedImpact]) -> int:
+        count = 0
         for impact in impacts:
-            report = self._analyzer.report(impact)
-            report["lane"] = self.lane_names[impact.lane]
-            if self.start_time:
-                for key in ("start_time", "raw_start_time"):
-                    if key in report:
-                        report[key] += self.start_time
-            self.impacts += 1
-            if self.on_detected is not None:
-                self.on_detected(impact, report)
-            self.on_impact(report)
-        return len(impacts)
+            for report in self._analyzer.reports(impact):
+                report["lane"] = self.lane_names[impact.lane]
+                if self.start_time:
+                    for key in ("start_time", "raw_start_time"):
+                        if key in report:
+                            report[key] += self.start_time
+                count += 1
+                if self.on_detected is not None:
+                    self.on_detected(impact, report)
+                self.on_impact(report)
+        self.impacts += count
+        return count
 
     def run(self, chunks: Iterable[bytes]) -> dict:
         """Consume ``chunks`` (bytes) to their end, or until SIGTERM/SIGINT (main thread) or

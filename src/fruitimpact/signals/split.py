@@ -1,0 +1,153 @@
+"""Two fruit in one contact, told apart (issue 13, item 2).
+
+When a second fruit (or a rebound) lands on the plate while another is still in contact, the force falls
+from the first maximum and rises again (``indices.second_pulse``).  Both contacts are the simulator's
+Hunt–Crossley pulse and forces on one plate add, so the contact is fitted as the sum of two pulses,
+
+    F(t) = F_A · H((t − t0_A)/T_A; x_A) + F_B · H((t − t0_B)/T_B; x_B),
+
+by the same Levenberg–Marquardt and tabulated shape H as one pulse (``signals.fit``), eight parameters,
+started from the two maxima and the dip between them.  The separation is accepted only when the sum
+leaves nothing but the noise (``MISFIT_LIMIT`` of the larger peak beyond it, as for one pulse), both
+pulses lie inside the window in order, and each is well above the noise; then each pulse is reported as
+its own contact, its indices measured on the samples less the other pulse's model, its fit the
+corresponding block of the joint fit (its standard errors from the joint covariance, so the other pulse's
+uncertainty is in them).  Otherwise the contact stays one report with status ``overlap``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .fit import (
+    MIN_PEAK_SNR,
+    RESULT_KEYS,
+    X_MAX,
+    _derived,
+    _derived_stderr,
+    _FIT_NAMES,
+    _levenberg_marquardt,
+    _Model,
+)
+
+__all__ = ["MISFIT_LIMIT", "split_contact"]
+
+#: The joint fit's residual beyond the noise may be at most this share of the larger peak (as for one pulse).
+MISFIT_LIMIT = 0.018
+#: Ratio T/t_c of the starting guesses (a Hunt–Crossley pulse with e ≈ 0.6; the fit moves it).
+_DURATION_OVER_RISE = 3.2
+_SMOOTH = 5
+
+
+class _TwoPulses:
+    """F(t; θ_A) + F(t; θ_B) and its Jacobian, for ``_levenberg_marquardt``."""
+
+    def __init__(self, t: np.ndarray):
+        self.first, self.second = _Model(t), _Model(t)
+
+    def __call__(self, theta, jacobian: bool = False):
+        if not jacobian:
+            return self.first.pulse(theta[:4]).copy() + self.second.pulse(theta[4:])
+        fa, ja = self.first.pulse(theta[:4], True)
+        fb, jb = self.second.pulse(theta[4:], True)
+        return fa + fb, np.hstack([ja, jb])
+
+
+def _landmarks(y: np.ndarray) -> tuple[int, int, int] | None:
+    """(first maximum, dip, second maximum) indices of the smoothed force, in time order."""
+    s = np.convolve(y, np.full(_SMOOTH, 1.0 / _SMOOTH), mode="same")
+    top = int(np.argmax(s))
+    after = s[top:]
+    rise = after - np.minimum.accumulate(after)
+    before = s[:top + 1]
+    fall = np.maximum.accumulate(before) - before
+    if rise.size and (not fall.size or rise.max() >= fall.max()):
+        second = top + int(np.argmax(rise))
+        dip = top + int(np.argmin(s[top:second + 1]))
+        return top, dip, second
+    if not fall.size or fall.max() <= 0:
+        return None
+    dip = int(np.argmax(fall))
+    first = int(np.argmax(s[:dip + 1]))
+    return first, dip, top
+
+
+def _onset(y: np.ndarray, end: int, level: float) -> int:
+    """Last index before ``end`` where y was at or below ``level`` (0 if none)."""
+    below = np.flatnonzero(y[:end] <= level)
+    return int(below[-1]) if below.size else 0
+
+
+def split_contact(time, force, noise: float, *, velocity=None, mass=None, diameter=None, poisson=None):
+    """Fit two pulses to one contact (module docstring).
+
+    ``time`` [s] and ``force`` [N] are the contact's window (baseline removed), ``noise`` the noise sd [N];
+    ``velocity`` or ``mass`` and ``diameter``/``poisson`` as for ``fit.fit_impact`` (applied to both).
+    Returns ((result_A, separated force A), (result_B, separated force B)) in time order, each result a dict
+    with the keys of ``fit.RESULT_KEYS``, or None when the contact is not separated."""
+    t = np.asarray(time, dtype=float)
+    y = np.asarray(force, dtype=float)
+    if t.size < 24 or not noise > 0:
+        return None
+    marks = _landmarks(y)
+    if marks is None:
+        return None
+    first, dip, second = marks
+    if not (first < dip < second):
+        return None
+    t_ref = float(t[0])
+    ts = t - t_ref
+    step = ts[1] - ts[0]
+    level = 3.0 * noise
+    start_a = _onset(y, first, level)
+    rise_a = max(ts[first] - ts[start_a], 3 * step)
+    start_b = dip - max(2, round(0.25 * (second - dip)))
+    rise_b = max(ts[second] - ts[start_b], 3 * step)
+    peak_a = max(float(y[first]), level)
+    peak_b = max(float(y[second] - 0.5 * y[dip]), level)
+    theta = np.array([ts[start_a], math.log(peak_a), math.log(_DURATION_OVER_RISE * rise_a), 1.0,
+                      ts[start_b], math.log(peak_b), math.log(_DURATION_OVER_RISE * rise_b), 1.0])
+    model = _TwoPulses(ts)
+    weights = np.full(ts.shape, 1.0 / noise)
+    try:  # a trial step far out (a duration of e^700) is a failed separation, not an error
+        theta, jac, _, iterations, converged, _ = _levenberg_marquardt(model, y, theta, weights, bounded=(3, 7))
+    except (OverflowError, ValueError, np.linalg.LinAlgError):
+        return None
+    residual = model(theta) - y
+    rms = float(np.sqrt(np.mean(residual ** 2)))
+    peaks = math.exp(theta[1]), math.exp(theta[5])
+    misfit = math.sqrt(max(rms ** 2 - noise ** 2, 0.0)) / max(peaks)
+    ends = theta[0] + math.exp(theta[2]), theta[4] + math.exp(theta[6])
+    if not (converged and misfit <= MISFIT_LIMIT and ts[0] <= theta[0] < theta[4] and max(ends) <= ts[-1]
+            and min(peaks) > MIN_PEAK_SNR * noise and theta[3] < X_MAX and theta[7] < X_MAX):
+        return None
+    try:
+        covariance = np.linalg.inv(jac.T @ jac)
+    except np.linalg.LinAlgError:
+        return None
+    args = (velocity if mass is None else None, mass, diameter, poisson)
+    out = []
+    for k, (lo, hi) in enumerate(((0, 4), (4, 8))):
+        part = theta[lo:hi]
+        values = _derived(part, *args)
+        block = covariance[lo:hi, lo:hi]
+        errors = _derived_stderr(part, block, args) if np.all(np.isfinite(block)) else np.full(values.shape, np.nan)
+        result = {name: math.nan for name in RESULT_KEYS}
+        for name, value, error in zip(_FIT_NAMES, values, errors):
+            result[name] = float(value)
+            result[name + "_stderr"] = float(error)
+        result["start_time"] += t_ref
+        for given, name in ((args[0], "velocity"), (mass, "mass")):
+            if given is not None:
+                result[name + "_stderr"] = 0.0
+        if diameter is None:
+            result["modulus_stderr"] = math.nan
+        inside = int(np.count_nonzero((ts > part[0]) & (ts < part[0] + math.exp(part[2]))))
+        result.update(fit_residual=rms, fit_residual_relative=rms / result["peak_force"], noise=noise,
+                      samples_in_contact=inside, converged=True, iterations=int(iterations),
+                      message="converged; one of two pulses in one contact, fitted together")
+        other = (model.second.pulse(theta[4:]) if k == 0 else model.first.pulse(theta[:4])).copy()
+        out.append((result, y - other))
+    return tuple(out)
