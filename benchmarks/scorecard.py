@@ -48,6 +48,7 @@ COLUMNS = [
     ("extra", "extra", "{:d}", "extra"),
     ("fruit→reb", "fruit_taken_for_rebounds", "{:d}", "fruit_taken_for_rebounds"),
     ("reb→fruit", "rebounds_taken_for_fruit", "{:d}", "rebounds_taken_for_fruit"),
+    ("of them flagged", "rebounds_taken_for_fruit_flagged", "{:d}", None),
     ("p95 ΔF/F", "peak_force_p95", "{:.2%}", "peak_force_p95"),
     ("p95 Δtc/tc", "time_to_peak_p95", "{:.2%}", "time_to_peak_p95"),
     ("med ΔK/K", "stiffness_median", "{:.2%}", "stiffness_median"),

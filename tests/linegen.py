@@ -651,6 +651,9 @@ def score(reports: list[dict], truth: dict, window: float = 1e-3) -> dict:
         extra=len(m["extra"]),
         fruit_taken_for_rebounds=sum(1 for c, r in pairs if not c["is_rebound"] and r.get("rebound", False)),
         rebounds_taken_for_fruit=sum(1 for c, r in pairs if c["is_rebound"] and not r.get("rebound", False)),
+        # of those, the ones the analysis said it could not decide (``rebound_ambiguous``): not silent
+        rebounds_taken_for_fruit_flagged=sum(1 for c, r in pairs if c["is_rebound"] and not r.get("rebound", False)
+                                             and r.get("rebound_ambiguous", False)),
         peak_force_p95=_p([_relative(r, c, "peak_force") for c, r in pairs], 95),
         time_to_peak_p95=_p([_relative(r, c, "time_to_peak") for c, r in pairs], 95),
         stiffness_median=_p([_relative(r, c, "stiffness") for c, r in fruit_pairs], 50),
