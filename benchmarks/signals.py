@@ -11,7 +11,7 @@ Each figure is measured beside its baseline in the same run (best of 3 wall-cloc
 * several lanes at once (per-lane throughput);
 * the raw indices per impact against a naive NumPy version (raw maximum, its index, and ``np.trapezoid``);
 * the text and float32 parsers against ``np.array(text.split(), float)`` and ``np.frombuffer``;
-* latency: samples from an impact's end to its emission (the design value is max(post-trigger, rebound
+* latency: samples from an impact's end to its emission (the design value is max(post-trigger, offset hold
   window) for an isolated impact), and, fed in real-time-sized chunks of 1 ms, the wall-clock time of the
   ``feed`` call that emits it (compute added on top of the design latency).
 
@@ -159,10 +159,10 @@ def main(argv=None) -> None:
     settings = DetectorSettings(hum_frequency=50.0)
     design = Detector(RATE, settings).latency_samples
     lat = np.array([i.emitted_at - 1 - i.end_index for i in found])
-    print(f"\n| latency (defaults: post-trigger {settings.post_trigger * 1e3:g} ms, rebound window "
-          f"{settings.rebound_window * 1e3:g} ms) | value |")
+    print(f"\n| latency (defaults: post-trigger {settings.post_trigger * 1e3:g} ms, offset hold "
+          f"{settings.offset_hold * 1e3:g} ms) | value |")
     print("|---|---|")
-    print(f"| design: max(post, rebound window) after end_index | {design} samples = {design / RATE * 1e3:.1f} ms |")
+    print(f"| design: max(post, offset hold) after end_index | {design} samples = {design / RATE * 1e3:.1f} ms |")
     print(f"| measured, end_index → emission, over {lat.size} impacts | min {lat.min()}, median "
           f"{int(np.median(lat))}, max {lat.max()} samples |")
     seconds = min(samples, 2_000_000)
@@ -178,7 +178,8 @@ def main(argv=None) -> None:
         (emit_times if emitted else feed_times).append(elapsed)
     analyzer.close()
     feed_times, emit_times = np.array(feed_times) * 1e6, np.array(emit_times) * 1e6
-    print(f"| StreamAnalyzer (float32 → detector → indices) fed 1 ms chunks: a chunk without emission | "
+    print(f"| StreamAnalyzer (float32 → detector → indices, shape fit, rebound test) fed 1 ms chunks: a chunk "
+          f"without emission | "
           f"median {np.median(feed_times):.0f} µs, 99th pct {np.percentile(feed_times, 99):.0f} µs |")
     print(f"| … the chunk that emits an impact (adds to the design latency) | "
           f"median {np.median(emit_times):.0f} µs, "

@@ -39,7 +39,7 @@ import numpy as np
 from ..constants import STANDARD_GRAVITY
 from .detect import DetectedImpact
 from .indices import impact_indices, second_pulse
-from .rebounds import PulseSummary, from_indices, judge, refine
+from .rebounds import PulseSummary, from_indices, judge, refine, shape_table
 from .sort import FirmnessClasses
 
 #: Keys of a fit that join the report (a contract: analyze --fit).
@@ -138,6 +138,10 @@ class LineAnalyzer:
         self._fruit_restitution: dict[int, list[float]] = {}
         #: per lane: the number of the next contact (a detected impact holds one or two contacts)
         self._sequence: dict[int, int] = {}
+        from .fit import prepare
+
+        prepare()  # the tables every contact needs, built before the first fruit lands, not while it waits
+        shape_table()
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
         """The dicts of the contacts in one detected impact, in time order (SI; ``public(report)`` is the

@@ -66,7 +66,7 @@ from ..engine.powerlaw import (
     powerlaw_single,
 )
 
-__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve",
+__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve", "prepare",
            "shape_table_error"]
 
 #: Largest x = c·V the fit explores (e ≈ 0.100); the projection keeps x in [0, X_MAX].
@@ -651,6 +651,12 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
                   samples_in_contact=inside, converged=bool(converged), iterations=int(iterations),
                   message="; ".join([message] + notes))
     return result
+
+
+def prepare() -> None:
+    """Build the pulse-shape table now (~0.25 s, once per process), so that a stream's first fit does not
+    pay for it while a fruit waits for its line."""
+    _shape_table()
 
 
 def at_velocity(result: dict, velocity: float) -> dict:
