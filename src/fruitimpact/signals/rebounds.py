@@ -39,9 +39,9 @@ flagged ambiguous, with the evidence (predicted and observed flight and peak).  
 (``pitch``) is a prior: a contact on the pitch grid of the lane's last fruit needs S ≤ 0.8 to be a
 rebound, one far off the grid S ≤ 1.25; without it the rule above alone decides.
 
-The measurements are the raw indices (``from_indices``), with or without a model fit, so that the
-decision is the same either way and is known before the fit (which then uses the rebound's speed r V_p).
-The shape x is read from h = ∫F dt / (F_max t_c), which for the force law is (1 + e(x))/(P(x) τ_c(x)), a
+The peak, time to peak and impulse are the raw indices (``from_indices``), the same with or without
+``--fit``, so the decision is too; the fit then splits the Hertz scales at the rebound's speed r V_p.
+The raw shape x is read from h = ∫F dt / (F_max t_c), which for the force law is (1 + e(x))/(P(x) τ_c(x)), a
 function of x alone, increasing up to x ≈ 2.6 (e ≈ 0.35) and flat near its top, so the raw x is weak
 for e ≈ 0.35–0.5 (its uncertainty is propagated).  So where a shape fit of the contact converged (the
 simulator's pulse fitted to its own samples, e ± 0.01 at 1 % noise; ``analysis`` fits every contact,
