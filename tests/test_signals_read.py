@@ -754,17 +754,57 @@ def test_tdms_mixed_sizes_interleaved(tmp_path):
     np.testing.assert_array_equal(one.lanes["daq/f"], x / 4)
 
 
-def test_tdms_many_segments_written_by_nptdms(tmp_path):
+def test_tdms_long_pieces_interleaved_and_in_chunks(tmp_path):
+    # pieces longer than a read block (2^16 values): interleaved rows of three sizes, chunks of two lanes
+    x = np.arange(300_000)
+    path = tmp_path / "long.tdms"
+    path.write_bytes(_tdms_segment([("s", (x % 30000).astype("i2")), ("f", (x / 4).astype("f4")),
+                                    ("d", (x / 8).astype("f8"))], interleaved=True, big=True)
+                     + _tdms_segment([("s", (x % 30000).astype("i2")), ("f", (x / 4).astype("f4")),
+                                      ("d", (x / 8).astype("f8"))], chunks=3))
+    rec, _ = _same_as_read(path, [1 << 16, 100_000, 1 << 20], rate=50.0)
+    expected = np.column_stack([x % 30000, x / 4, x / 8])
+    np.testing.assert_array_equal(_matrix(rec), np.concatenate([expected, expected]))
+    np.testing.assert_array_equal(_matrix(rec), _nptdms_values(path, rec.lane_names))
+
+
+def _runs(path) -> dict:
+    """How the TDMS reader will read each lane: its runs of pieces at fixed offsets, or None (nptdms)."""
+    from nptdms import TdmsFile
+
+    from fruitimpact.signals.read.tdms import _plan
+
+    with TdmsFile.open(path) as tdms:
+        segments = tdms._reader._segments
+        return {f"{g.name}/{c.name}": _plan(segments, c) for g in tdms.groups() for c in g.channels()}
+
+
+def test_tdms_plain_data_is_read_at_its_offsets(tmp_path):
+    # not through nptdms's slices (which read a whole raw-data chunk for every slice): a logger's segments
+    # laid out alike are one run; a scaled or DAQmx channel is left to nptdms
+    runs = _runs(_many_segments(tmp_path / "many.tdms", np.zeros((3, 5000))))
+    assert all(lane is not None and len(lane) == 1 and lane[0].pieces == 20 for lane in runs.values()), runs
+    for name in ("big_endian.tdms", "raw_timestamps.tdms", "Digital_Input.tdms"):
+        assert all(lane is not None for lane in _runs(_example(name)).values())
+    assert all(lane is None for lane in _runs(_example("raw1.tdms")).values())
+
+
+def _many_segments(path, x: np.ndarray):
+    """Lanes ``x`` (lanes × samples, kN) written by nptdms as a logger does: 250 samples per segment."""
     from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
-    x = RNG.normal(0.0, 1.0, (3, 5000))
     properties = {"wf_increment": 1e-4, "unit_string": "kN"}
-    with TdmsWriter(str(tmp_path / "many.tdms")) as writer:
-        for k in range(0, 5000, 250):
+    with TdmsWriter(str(path)) as writer:
+        for k in range(0, x.shape[1], 250):
             objects = [RootObject({}), GroupObject("daq")] if k == 0 else []
             writer.write_segment(objects + [ChannelObject("daq", f"c{j}", x[j, k:k + 250], properties=properties)
-                                            for j in range(3)])
-    rec, _ = _same_as_read(tmp_path / "many.tdms", [1, 249, 251, 4096])
+                                            for j in range(x.shape[0])])
+    return path
+
+
+def test_tdms_many_segments_written_by_nptdms(tmp_path):
+    x = RNG.normal(0.0, 1.0, (3, 5000))
+    rec, _ = _same_as_read(_many_segments(tmp_path / "many.tdms", x), [1, 249, 251, 4096])
     np.testing.assert_array_equal(_matrix(rec), x.T * 1e3)
 
 

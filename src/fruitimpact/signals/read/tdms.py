@@ -1,17 +1,19 @@
 """NI TDMS recordings (through ``nptdms``), read block by block.
 
-The file is opened with ``nptdms.TdmsFile.open``, which reads only the metadata (the segments'
-object lists and the properties).  Samples are then read straight from the segments' raw data:
-for a plain segment (values of a fixed-size number type, contiguous or interleaved, not DAQmx, no
-scaling) every channel's values are at known byte offsets, so a block of rows is one read per lane
-whatever the size of the segment.  nptdms's own channel slices read whole raw-data chunks (a file
-written as one segment would be read whole for every slice), so they are used only for what is
-not plain (DAQmx raw data, scaled channels), block by block.
+The file's metadata (the segments' object lists and the properties) is read once, by
+``nptdms.TdmsFile.open``, when it is opened.  Each lane's values are then located: runs of pieces at
+regular byte offsets (one run per raw-data chunk layout; segments laid out alike, as a logger writes
+them, merge into one run), so nothing per segment is kept and a block of rows is a few reads per lane
+whatever the size or number of the segments.  This holds for plain data: numbers of a fixed size,
+contiguous or interleaved, little- or big-endian, a last segment cut short.  nptdms's own channel
+slices read whole raw-data chunks (a file written as one segment would be read whole for every
+slice), so they are used only for the rest (DAQmx raw data, scaled channels), block by block.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -25,13 +27,11 @@ from .common import (
     error,
     need_rate,
     open_file,
-    read_exactly,
+    read_some,
 )
 
 # Table-of-contents flags of a segment's lead-in (the TDMS file format; nptdms.common.toc_properties).
-_RAW_DATA, _INTERLEAVED, _BIG_ENDIAN, _DAQMX = 1 << 3, 1 << 5, 1 << 6, 1 << 7
-#: Buffer of each lane's file handle [bytes]: small segments are served from it without a system call.
-_LANE_BUFFER = 1 << 18
+_INTERLEAVED, _BIG_ENDIAN, _DAQMX = 1 << 5, 1 << 6, 1 << 7
 
 
 def _property_number(path, name: str, properties, key: str):
@@ -58,10 +58,11 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
         raise error(path, "empty file")
     tdms_file = _nptdms(path)
     try:
-        with tdms_file.open(path) as tdms:
-            # (lane name, group, channel, dtype, length, properties)
+        with tdms_file.open(path) as tdms:  # the metadata stays readable once the file is closed
+            # (lane name, group, channel, dtype, length, properties, the nptdms channel)
             channels = [(f"{group.name}/{channel.name}", group.name, channel.name, channel.dtype, len(channel),
-                         dict(channel.properties)) for group in tdms.groups() for channel in group.channels()]
+                         dict(channel.properties), channel) for group in tdms.groups() for channel in group.channels()]
+            segments = getattr(getattr(tdms, "_reader", None), "_segments", None)  # nptdms internals: see _plan
     except Exception as exc:  # noqa: BLE001 - nptdms raises ValueError, KeyError, struct.error … on damaged files
         raise error(path, f"not a readable TDMS file ({exc})") from None
     if not channels:
@@ -74,7 +75,7 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
         if len(chosen) > 1:
             raise error(path, f"column {column!r} is ambiguous: it matches {', '.join(repr(c[0]) for c in chosen)}; "
                               f"give group/channel", "column")
-        name, _, _, dtype, length, _ = chosen[0]
+        name, _, _, dtype, length, _, _ = chosen[0]
         if dtype.kind not in "iuf":
             raise error(path, f"channel {name!r} holds {dtype} values, not numbers", "column")
         if length == 0:
@@ -87,7 +88,7 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
         if not chosen:
             raise error(path, "all lanes empty: no channel has samples")
     scales, rates, starts, lengths, clips = {}, {}, {}, {}, {}
-    for name, _, _, _, length, properties in chosen:
+    for name, _, _, _, length, properties, _ in chosen:
         unit = str(properties.get("unit_string", "")).strip()
         if unit and unit not in FORCE_UNITS:
             raise error(path, f"channel {name!r} has unit {unit!r}; a force lane must be in N, kN or mN "
@@ -128,8 +129,10 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
         raise error(path, f"lanes differ in clip_low/clip_high ({listing(clips)} N){advice}")
     clip_low, clip_high = next(iter(clips.values()))
     names = tuple(c[0] for c in chosen)
-    lanes = [(c[1], c[2], scales[c[0]]) for c in chosen]
     samples = next(iter(lengths.values()))
+    # each lane: its unit's scale, and where its values are (None: read through nptdms)
+    lanes = [(c[1], c[2], scales[c[0]], _plan(segments, c[6])) for c in chosen]
+    del tdms, segments, channels, chosen  # nptdms's metadata (objects per segment) is not kept
 
     def blocks(hint: int):
         return _blocks(path, names, lanes, samples, max(hint, BLOCK_SAMPLES))
@@ -142,30 +145,184 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
 # --------------------------------------------------------------------------- reading the samples
 
 class _NotPlain(Exception):
-    """A segment whose raw data is not at fixed byte offsets (DAQmx, unsized types, scaling)."""
+    """A segment whose raw data is not at fixed byte offsets (DAQmx, unsized types)."""
 
 
-def _blocks(path, names: tuple[str, ...], lanes: list[tuple[str, str, float]], samples: int, block: int):
+class _Run(NamedTuple):
+    """``pieces`` pieces of ``count`` values of a lane: value i of piece p is at byte
+    start + p·step + shift + i·stride; ``start`` is where the piece's chunk (contiguous) or first row
+    (interleaved) begins, so a read from there takes the other lanes' values beside it too."""
+
+    start: int
+    shift: int
+    count: int
+    stride: int
+    pieces: int
+    step: int
+    dtype: np.dtype
+
+
+def _plan(segments, channel) -> list[_Run] | None:
+    """Where a channel's values are, in order, segments laid out alike merged into one run; None when
+    nptdms must read it (scaled, DAQmx, unsized types, or nptdms's internals not as expected).
+    ``segments``: nptdms's list of the file's segments."""
+    try:
+        if segments is None or getattr(channel, "_scaling", True) is not None:
+            return None
+        runs: list[_Run] = []
+        for segment in segments:
+            for run in _segment_runs(segment, channel.path):
+                last = runs[-1] if runs else None
+                if last is not None and run.pieces == 1 and (last.shift, last.count, last.stride, last.dtype) == \
+                        (run.shift, run.count, run.stride, run.dtype):
+                    step = last.step if last.pieces > 1 else run.start - last.start
+                    if step >= run.shift + (run.count - 1) * run.stride + run.dtype.itemsize and \
+                            run.start == last.start + last.pieces * step:
+                        runs[-1] = last._replace(pieces=last.pieces + 1, step=step)
+                        continue
+                runs.append(run)
+    except (_NotPlain, AttributeError, TypeError, KeyError):
+        return None
+    if sum(run.count * run.pieces for run in runs) != len(channel):
+        return None
+    return runs
+
+
+def _segment_runs(segment, channel_path: str):
+    """The runs of one segment: one of its raw-data chunks (contiguous: the channel's values at the
+    same place in every chunk; a last chunk cut short apart), or one of all its rows (interleaved)."""
+    if not segment.num_chunks:
+        return
+    objects = [o for o in segment.ordered_objects if o.has_data]
+    target = next((o for o in objects if o.path == channel_path), None)
+    if target is None or target.number_values == 0:
+        return
+    if segment.toc_mask & _DAQMX or any(type(o).__name__ != "TdmsSegmentObject" for o in objects):
+        raise _NotPlain
+    dtype = target.data_type.nptype
+    if dtype is None or dtype.kind not in "iuf" or dtype.itemsize != target.data_type.size:
+        raise _NotPlain
+    dtype = np.dtype(dtype).newbyteorder(">" if segment.toc_mask & _BIG_ENDIAN else "<")
+    override = segment.final_chunk_lengths_override
+    chunks = segment.num_chunks
+    if segment.toc_mask & _INTERLEAVED:
+        if any(o.data_type.size is None for o in objects):
+            raise _NotPlain
+        width = sum(o.data_type.size for o in objects)
+        shift = sum(o.data_type.size for o in objects[:objects.index(target)])
+        rows = target.number_values * chunks if override is None else \
+            target.number_values * (chunks - 1) + override.get(channel_path, 0)
+        if rows:
+            yield _Run(segment.data_position, shift, rows, width, 1, rows * width, dtype)
+        return
+    size = sum(o.data_size for o in objects)  # bytes of one chunk
+    whole = chunks if override is None else chunks - 1
+    shift = 0
+    for o in objects:
+        if o is target:
+            break
+        shift += o.data_size
+    if whole:
+        yield _Run(segment.data_position, shift, target.number_values, dtype.itemsize, whole, size, dtype)
+    if override is not None:  # the last chunk, cut short: each object's values are fewer
+        position = segment.data_position + whole * size
+        shift = 0
+        for o in objects:
+            count = override.get(o.path, 0)
+            if o is target:
+                if count:
+                    yield _Run(position, shift, count, dtype.itemsize, 1, size, dtype)
+                break
+            if count == o.number_values:
+                shift += o.data_size
+            elif o.data_type.size is not None:
+                shift += o.data_type.size * count
+            else:
+                raise _NotPlain
+
+
+#: Most bytes read at once to take several short pieces of a lane (with the other lanes' bytes between).
+_SPAN_BYTES = 1 << 22
+
+
+def _read_at(handle, path, position: int, size: int) -> bytes:
+    """Up to ``size`` bytes of the file from byte ``position``."""
+    try:
+        handle.seek(position)
+    except OSError as exc:
+        raise error(path, exc.strerror or str(exc)) from None
+    return read_some(handle, path, size)
+
+
+class _Window:
+    """Reads of the file shared by the lanes: the last two are kept, so the lanes after the first find
+    their values in what the first one read (interleaved rows, chunks of small segments)."""
+
+    def __init__(self, handle, path):
+        self.handle, self.path, self.kept = handle, path, []
+
+    def get(self, position: int, size: int, origin: int, length: int) -> memoryview:
+        """Bytes [position, position + size) of the file; when not kept, read from ``origin`` (≤ position)
+        ``length`` bytes or up to the end of the file, whichever is less, but at least to position + size."""
+        for start, data in self.kept:
+            if start <= position and position + size <= start + len(data):
+                return data[position - start:position - start + size]
+        data = memoryview(_read_at(self.handle, self.path, origin, max(length, position + size - origin)))
+        if len(data) < position + size - origin:
+            raise error(self.path, f"the file ends at byte {origin + len(data)}, before byte {position + size} its "
+                                   f"metadata promises (truncated, or changed since it was opened)")
+        self.kept = self.kept[-1:] + [(origin, data)]
+        return data[position - origin:position - origin + size]
+
+
+def _read_runs(window: _Window, runs: list[_Run], block: int):
+    """The values of ``runs`` (their own dtype), in arrays of at most ``block`` values and about
+    ``_SPAN_BYTES`` read: a long piece in parts, short pieces several at once (one read, a strided view)."""
+    for run in runs:
+        item = run.dtype.itemsize
+        part = max(1, min(block, _SPAN_BYTES // run.stride))  # values of a long piece read at once
+        if run.count > part:
+            for piece in range(run.pieces):
+                for first in range(0, run.count, part):
+                    n = min(part, run.count - first)
+                    rows = run.start + piece * run.step + first * run.stride  # interleaved: where the rows begin
+                    position, size = rows + run.shift, (n - 1) * run.stride + item
+                    data = window.get(position, size, rows, n * run.stride) if run.stride > item else \
+                        window.get(position, size, position, size)
+                    yield np.ndarray((n,), run.dtype, data, 0, (run.stride,))
+            continue
+        together = max(1, min(block // run.count, _SPAN_BYTES // run.step))
+        for first in range(0, run.pieces, together):
+            m = min(together, run.pieces - first)
+            origin = run.start + first * run.step
+            position, size = origin + run.shift, (m - 1) * run.step + (run.count - 1) * run.stride + item
+            # the other lanes' values between the pieces are read too, unless that is much more than these
+            data = window.get(position, size, origin, m * run.step) if run.step <= _SPAN_BYTES else \
+                window.get(position, size, position, size)
+            yield np.ndarray((m, run.count), run.dtype, data, 0, (run.step, run.stride)).reshape(-1)
+
+
+def _blocks(path, names: tuple[str, ...], lanes: list[tuple], samples: int, block: int):
     """Blocks of ``block`` rows (the last one shorter): each lane's values × its unit's scale [N]."""
-    tdms_file = _nptdms(path)
+    handle, tdms, streams = None, None, []
     try:
-        tdms = tdms_file.open(path)
-    except Exception as exc:  # noqa: BLE001 - as in open_tdms
-        raise error(path, f"not a readable TDMS file ({exc})") from None
-    handles = []
-    try:
-        streams = []
-        for group, channel_name, scale in lanes:
+        for group, channel_name, scale, runs in lanes:
+            if runs is not None:
+                if handle is None:
+                    handle = open_file(path)
+                    window = _Window(handle, path)
+                streams.append(_Lane(_read_runs(window, runs, block), scale))
+                continue
+            if tdms is None:
+                try:
+                    tdms = _nptdms(path).open(path)
+                except Exception as exc:  # noqa: BLE001 - as in open_tdms
+                    raise error(path, f"not a readable TDMS file ({exc})") from None
             channel = tdms[group][channel_name]
             if len(channel) != samples:
                 raise error(path, f"channel {group}/{channel_name} now has {len(channel)} samples, not {samples} "
                                   f"(the file changed since it was opened)")
-            pieces = _plain_pieces(tdms, channel)
-            if pieces is None:
-                streams.append(_Lane(_sliced(path, channel, samples, block), scale))
-            else:
-                handles.append(open_file(path, buffering=_LANE_BUFFER))
-                streams.append(_Lane(_read_pieces(handles[-1], path, pieces, block), scale))
+            streams.append(_Lane(_sliced(path, channel, samples, block), scale))
         for start in range(0, samples, block):
             out = np.empty((min(block, samples - start), len(lanes)))
             for k, lane in enumerate(streams):
@@ -176,9 +333,10 @@ def _blocks(path, names: tuple[str, ...], lanes: list[tuple[str, str, float]], s
             check_finite(path, names, out, start)
             yield out
     finally:
-        for handle in handles:
+        if handle is not None:
             handle.close()
-        tdms.close()
+        if tdms is not None:
+            tdms.close()
 
 
 class _Lane:
@@ -213,81 +371,6 @@ def _sliced(path, channel, samples: int, block: int):
         except Exception as exc:  # noqa: BLE001 - as in open_tdms
             raise error(path, f"not a readable TDMS file ({exc})") from None
         yield np.asarray(values)
-
-
-def _plain_pieces(tdms, channel):
-    """The channel's raw data as pieces (byte offset of the first value, values, bytes from one value
-    to the next, dtype) when every segment holding it is plain and they hold all its values; else None."""
-    try:
-        if getattr(channel, "_scaling", True) is not None:
-            return None
-        segments = tdms._reader._segments
-        total = 0
-        for segment in segments:  # a first pass to check, without keeping anything
-            for _, count, _, _ in _segment_pieces(segment, channel.path):
-                total += count
-    except (_NotPlain, AttributeError, TypeError, KeyError):
-        return None
-    if total != len(channel):
-        return None
-    return (piece for segment in segments for piece in _segment_pieces(segment, channel.path))
-
-
-def _segment_pieces(segment, channel_path: str):
-    """The pieces of one segment: one per raw-data chunk (contiguous), or one for the whole segment
-    (interleaved: rows of every channel's value)."""
-    if not segment.num_chunks:
-        return
-    objects = [o for o in segment.ordered_objects if o.has_data]
-    target = next((o for o in objects if o.path == channel_path), None)
-    if target is None or target.number_values == 0:
-        return
-    if segment.toc_mask & _DAQMX or any(type(o).__name__ != "TdmsSegmentObject" for o in objects):
-        raise _NotPlain
-    dtype = target.data_type.nptype
-    if dtype is None or dtype.kind not in "iuf" or dtype.itemsize != target.data_type.size:
-        raise _NotPlain
-    dtype = np.dtype(dtype).newbyteorder(">" if segment.toc_mask & _BIG_ENDIAN else "<")
-    override = segment.final_chunk_lengths_override
-    last = segment.num_chunks - 1
-    if segment.toc_mask & _INTERLEAVED:
-        if any(o.data_type.size is None for o in objects):
-            raise _NotPlain
-        width = sum(o.data_type.size for o in objects)
-        shift = sum(o.data_type.size for o in objects[:objects.index(target)])
-        rows = target.number_values * segment.num_chunks if override is None else \
-            target.number_values * last + override.get(channel_path, 0)
-        yield segment.data_position + shift, rows, width, dtype
-        return
-    chunk = sum(o.data_size for o in objects)
-    for index in range(segment.num_chunks):
-        position = segment.data_position + index * chunk
-        final = override is not None and index == last
-        for o in objects:
-            count = override.get(o.path, 0) if final else o.number_values
-            if o is target:
-                if count:
-                    yield position, count, dtype.itemsize, dtype
-                break
-            if count == o.number_values:
-                position += o.data_size
-            elif o.data_type.size is not None:
-                position += o.data_type.size * count
-            else:
-                raise _NotPlain
-
-
-def _read_pieces(handle, path, pieces, block: int):
-    """The values of ``pieces`` (their own dtype), in arrays of at most ``block`` values."""
-    for position, count, stride, dtype in pieces:
-        for start in range(0, count, block):
-            n = min(block, count - start)
-            size = (n - 1) * stride + dtype.itemsize
-            data = read_exactly(handle, path, position + start * stride, size)
-            if stride == dtype.itemsize:
-                yield np.frombuffer(data, dtype)
-            else:  # interleaved: every stride-th bytes
-                yield np.ndarray((n,), dtype, data, 0, (stride,))
 
 
 __all__ = ["open_tdms"]
