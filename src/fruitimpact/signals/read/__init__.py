@@ -182,7 +182,7 @@ def read_recording(path, *, rate: float | None = None, column: str | None = None
         the ADC limits [N] when the file states them, and ``source`` = the path.
 
     Raises ``ValueError`` (one line) as ``open_recording`` and its ``chunks``
-    do.  Memory: the recording itself, about three times over while it is
+    do.  Memory: the recording itself, two (three for CSV) times over while it is
     built; use ``open_recording(...).chunks()`` for files larger than memory.
     """
     source = open_recording(path, rate=rate, column=column, format=format, lanes=lanes)
