@@ -2,7 +2,8 @@
 synthetic sensor with a known truth.
 
 * ``recording``: ``Recording``, force lanes [N] sampled together at one rate [Hz].
-* ``read``: ``read_recording(path)`` for CSV, NumPy ``.npy``, raw float32 and NI TDMS files.
+* ``read``: ``read_recording(path)`` for CSV, NumPy ``.npy``, raw float32 and NI TDMS files, and
+  ``open_recording(path)`` to read any length in chunks (memory bounded by the chunk).
 * ``synth``: ``SensorModel``, ``Impact``, ``Population``, ``synthesize`` (recording + truth),
   ``write_recording``, ``write_truth``.
 
@@ -10,7 +11,7 @@ SI units throughout.  Importing this package loads neither the engine nor SciPy,
 or nptdms: each is imported by the function that needs it.
 """
 
-from .read import read_recording
+from .read import open_recording, read_recording
 from .recording import Recording
 from .synth import (
     Impact,
@@ -22,5 +23,5 @@ from .synth import (
     write_truth,
 )
 
-__all__ = ["Impact", "Population", "Recording", "SensorModel", "read_recording", "synthesize", "truth_path",
-           "write_recording", "write_truth"]
+__all__ = ["Impact", "Population", "Recording", "SensorModel", "open_recording", "read_recording", "synthesize",
+           "truth_path", "write_recording", "write_truth"]
