@@ -6,8 +6,9 @@ of the same fruit at its exit speed e V: what a rebound *is*.  A rebound lands a
 body leaving at e V (no drag).  Each test states the physical fact it checks and why its margin is what it is.
 
 Item 2 is checked on signals built from the exact pulses (``powerlaw_curves``) with 1 % white noise: two fruit a
-few milliseconds apart are two contacts measured each on its own samples; two fruit in one contact are one
-report with status "overlap" and no firmness, never one fruit fitted through both.
+few milliseconds apart are two contacts measured each on its own samples; two fruit in one contact are told
+apart by a joint fit of two pulses, or are one report with status "overlap" and no firmness: never one fruit
+fitted through both.
 """
 
 from __future__ import annotations

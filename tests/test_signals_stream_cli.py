@@ -85,3 +85,12 @@ def test_raw_float32_fed_as_text_is_refused_early_in_one_line():
     assert result.returncode == 2, err
     assert "looks like binary" in err and "--format f32" in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_text_with_another_count_of_numbers_than_lanes_is_refused_early():
+    """One number per line fed with --lanes 2: every line would be skipped; one clear line instead (exit 2)."""
+    text = "".join(f"{v:.4f}\n" for v in np.random.default_rng(3).normal(0.0, 0.3, 2000))
+    result = subprocess.run([console_script(), "stream", "--rate", "20000", "--lanes", "2"], input=text,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert "--lanes" in result.stderr and len(result.stderr.strip().splitlines()) == 1

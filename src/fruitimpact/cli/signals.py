@@ -75,7 +75,7 @@ def analysis_from(args, rate: float):
         if not low < high:
             raise UsageError(f"argument --clip: LOW must be below HIGH; got {args.clip!r}")
         clip = (low, high)
-    velocity = _float("--velocity", args.velocity, "velocity")
+    velocity = _float("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop
     height = _float("--drop-height", args.drop_height, "length", high=10.0)
     if velocity is not None and height is not None:
         raise UsageError("give either --velocity or --drop-height, not both")
@@ -127,7 +127,7 @@ ANALYZE_CHUNK = 1 << 18
 
 
 def _table_header(analysis) -> str:
-    header = f"{'lane':<10}{'t [s]':>10}{'F_max [N]':>11}{'t_c [ms]':>10}{'T [ms]':>9}{'C [N/ms]':>10}" \
+    header = f"{'lane':<10}{'#':>6}{'t [s]':>10}{'F_max [N]':>11}{'t_c [ms]':>10}{'T [ms]':>9}{'C [N/ms]':>10}" \
              f"{'C* [N/ms²]':>12}{'impulse':>10}  status/flags"
     if analysis.fit:
         header += "   k_c, e, m|V"
@@ -140,7 +140,7 @@ def _table_row(r: dict, analysis) -> str:
         flags.append(f"rebound of #{r['rebound_of']}")
     if r.get("rebound_ambiguous"):
         flags.append("ambiguous")
-    line = (f"{r['lane']:<10}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"
+    line = (f"{r['lane']:<10}{r['sequence']:>6d}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"
             f"{r['contact_duration'] * 1e3:>9.4g}{r['firmness_c'] / 1e3:>10.4g}"
             f"{r['firmness_c_star'] / 1e6:>12.4g}{r['impulse']:>10.4g}  {','.join(flags) or '-'}")
     if analysis.fit:
@@ -212,16 +212,24 @@ def cmd_analyze(args) -> int:
         print(_table_header(analysis))
     progress = _Progress(source.samples, source.rate) if args.progress else None
     done = 0
-    try:
-        for chunk in source.chunks(ANALYZE_CHUNK):
-            analyzer.feed(chunk)
-            done += chunk.shape[0]
+    with _sigterm_as_interrupt():
+        try:
+            for chunk in source.chunks(ANALYZE_CHUNK):
+                analyzer.feed(chunk)
+                done += chunk.shape[0]
+                if progress is not None:
+                    progress.update(done, analyzer.impacts)
+        except ValueError as exc:  # a bad row found mid-file: the samples before its block stand
+            analyzer.close()  # contacts in progress there are reported as truncated
             if progress is not None:
-                progress.update(done, analyzer.impacts)
-    except ValueError as exc:  # a bad row found mid-file: what was analysed before it stands
-        sys.stdout.flush()
-        raise UsageError(_reading_error(exc, args)) from None
-    analyzer.close()
+                progress.update(done, analyzer.impacts, final=True)
+            sys.stdout.flush()
+            raise UsageError(_reading_error(exc, args)) from None
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: what is known is written, then "interrupted"
+            analyzer.close()
+            sys.stdout.flush()
+            raise
+        analyzer.close()
     if progress is not None:
         progress.update(done, analyzer.impacts, final=True)
     if not args.json:
@@ -236,6 +244,30 @@ def cmd_analyze(args) -> int:
         if not args.json:
             print(f"figure written to {args.plot}")
     return 0
+
+
+class _sigterm_as_interrupt:
+    """While active (main thread): SIGTERM ends the command like Ctrl-C (the held contacts are flushed and
+    the lines written, exit 130), instead of killing it with its output half written."""
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        self._previous = None
+        if threading.current_thread() is threading.main_thread():
+            def interrupt(signum, frame):
+                raise KeyboardInterrupt
+
+            self._previous = signal.signal(signal.SIGTERM, interrupt)
+        return self
+
+    def __exit__(self, *exc):
+        import signal
+
+        if self._previous is not None:
+            signal.signal(signal.SIGTERM, self._previous)
+        return False
 
 
 def _reading_error(exc: ValueError, args) -> str:

@@ -14,8 +14,9 @@ For each contact, in order, as soon as the detector emits it (nothing waits for 
    measured on its own samples.
 2. **Raw indices** (``indices.impact_indices``).
 3. **Overlap.**  A contact whose force falls and rises again by more than ``OVERLAP_FRACTION`` of its
-   peak (``indices.second_pulse``) holds two fruit (or a fruit and a rebound): status ``overlap``, no
-   firmness, no fit, no class.
+   peak (``indices.second_pulse``), or that no single pulse fits (``split.MISFIT_LIMIT``), holds two fruit
+   (or a fruit and a rebound): fitted as two pulses (``signals.split``), each becomes its own contact;
+   when that fails, one report with status ``overlap``, no firmness, no fit, no class.
 4. **Rebound or new fruit** (``signals.rebounds``): decided from the contacts before it, by the
    fruit's own physics (flight, speed ratio, peak, time to peak, shape), with the evidence when the
    decision is near its boundary.
@@ -41,6 +42,7 @@ from .detect import DetectedImpact
 from .indices import impact_indices, second_pulse
 from .rebounds import PulseSummary, from_indices, judge, refine, shape_table
 from .sort import FirmnessClasses
+from .split import MISFIT_LIMIT, split_contact
 
 #: Keys of a fit that join the report (a contract: analyze --fit).
 FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
@@ -48,11 +50,6 @@ FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
 REPORT_KEYS = ("sequence", "status", "message", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence")
 #: A second rise (or an earlier fall) larger than this share of the peak is a second fruit in the contact.
 OVERLAP_FRACTION = 0.10
-#: A fit whose residual beyond the noise, √(rms² − σ²), exceeds this share of the peak is not one pulse.
-#: One Hunt–Crossley contact leaves the noise plus a structured part (plate ringing, hum left over) of at most
-#: 1.6 % of its peak over the line scenarios of tests/linegen.py (2–3 kHz ringing, ζ 0.03–0.1, hum, drift) and
-#: 0.9 % in tests/test_signals_detect.py; two fruit landing within a fraction of a time to peak leave 2–10 %.
-MISFIT_LIMIT = 0.018
 #: Firmness indices withheld from an overlap (they would describe neither fruit).
 FIRMNESS_KEYS = ("firmness_c", "firmness_c_star")
 #: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
@@ -184,8 +181,6 @@ class LineAnalyzer:
 
     def _split(self, own: DetectedImpact):
         """Two (piece, fit) of a contact holding two pulses, or None (``signals.split``)."""
-        from .split import split_contact
-
         analysis = self.analysis
         time = (own.window_start + np.arange(own.window.size)) / analysis.rate
         parts = split_contact(time, own.window, own.noise, velocity=1.0 if analysis.mass is None else None,

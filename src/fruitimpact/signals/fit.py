@@ -598,7 +598,8 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
     theta, message = _start(ts, ys, model, weights)
     if theta is None:
         return _empty_result(message)
-    theta, jac, r, iterations, converged, message = _levenberg_marquardt(model, ys, theta, weights)
+    with np.errstate(over="ignore", invalid="ignore"):  # a far trial step is rejected, not worth a warning
+        theta, jac, r, iterations, converged, message = _levenberg_marquardt(model, ys, theta, weights)
 
     t0, duration, x = theta[0], math.exp(theta[2]), theta[3]
     inside = int(np.count_nonzero((ts > t0) & (ts < t0 + duration)))

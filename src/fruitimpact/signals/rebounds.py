@@ -29,7 +29,7 @@ Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
   own error in quadrature);
 * speed ratio r against e_p: −25 % / +10 % (energy lost to spin and tangential motion lowers the
   vertical rebound speed, nothing raises it: a fruit cannot come back faster than it left; e_p itself
-  is uncertain by its standard error, added in quadrature);
+  is uncertain: 3 × its relative standard error is added in quadrature);
 * peak force and time to peak: 3 × √(σ_meas² + 4 %²), the 4 % for a rebound landing on another spot
   of the fruit (local radius and modulus ±10 % move F_max and t_c by ~4 %: both go as K^±0.4);
 * shape: x_j against r x_p within 3 × √(σ_j² + (r σ_p)² + (0.1 r x_p)²).

@@ -96,6 +96,8 @@ class TextSource(_Source):
         self.malformed = 0
         self._line_number = 0
         self._binary_lines = 0
+        self._wrong_count = 0
+        self._counted = 0
 
     def parse(self, chunk: bytes) -> np.ndarray:
         data = self._partial + bytes(chunk)
@@ -163,6 +165,12 @@ class TextSource(_Source):
         """Refuse input that is mostly not text within its first BINARY_LINES lines (module docstring)."""
         self._binary_lines += sum(1 for line in raw_lines if "\x00" in line or "\ufffd" in line)
         lines = self._line_number + len(raw_lines)
+        counts = [len(line.replace(",", " ").split()) for line in raw_lines if line.strip()]
+        self._wrong_count += sum(1 for n in counts if n != self.lanes)
+        self._counted += len(counts)
+        if self._counted >= BINARY_LINES // 2 and self._wrong_count == self._counted and not self._binary_lines:
+            raise ValueError(f"argument --lanes: every one of the first {self._counted} lines holds another count "
+                             f"of numbers than --lanes {self.lanes} (e.g. {counts[0]}): give --lanes as in the input")
         if self._binary_lines > 8 and self._binary_lines > lines // 2:
             raise ValueError(f"argument --format: the input looks like binary ({self._binary_lines} of its first "
                              f"{lines} lines hold NUL bytes or invalid UTF-8): give --format f32 for raw float32")
