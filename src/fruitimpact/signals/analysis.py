@@ -135,10 +135,7 @@ class LineAnalyzer:
         self._fruit_restitution: dict[int, list[float]] = {}
         #: per lane: the number of the next contact (a detected impact holds one or two contacts)
         self._sequence: dict[int, int] = {}
-        from .fit import prepare
-
-        prepare()  # the tables every contact needs, built before the first fruit lands, not while it waits
-        shape_table()
+        _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
         """The dicts of the contacts in one detected impact, in time order (SI; ``public(report)`` is the
@@ -286,6 +283,47 @@ class LineAnalyzer:
             "reason": f"could be the rebound of a fruit in contact #{sequence}, which held two pulses and could "
                       f"not be measured: it came {summary.onset - end:.3f} s after it with e {summary.restitution:.2f} "
                       f"above the lane's {lane_e:.2f}"}
+
+
+_WARM: set = set()
+
+
+def _warm_up(analysis: Analysis) -> None:
+    """Build the pulse tables and load every compiled function a contact's report uses (~0.1–0.5 s once per
+    process and rate), by analysing a synthetic apple impact and a pair of them: a stream's first fruit then
+    costs what the others cost (without it the first report took 46–71 ms, benchmarks/latency.py)."""
+    if analysis.rate in _WARM:
+        return
+    from ..engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
+    from .fit import at_velocity, prepare
+
+    prepare()
+    shape_table()
+    rate = analysis.rate
+    mass, stiffness, velocity = 0.19, 1.2e6, 1.0
+    c = float(exact_x(0.6)) / velocity
+    duration = powerlaw_characteristics(mass, stiffness, c, velocity, 0.0375)[0][2]
+    pre = max(8, round(2e-3 * rate))
+    n = pre + round(2.5 * duration * rate) + pre
+    t = (np.arange(n) - pre) / rate
+    pulse = np.zeros(n)
+    for shift in (0.0, 0.6 * duration):  # one pulse, then two in one contact
+        inside = (t > shift) & (t < shift + duration)
+        pulse[inside] += powerlaw_curves(mass, stiffness, c, velocity, t[inside] - shift)[2]
+        window = pulse + 0.01 * np.sin(np.arange(n))  # a little "noise" so the fits have residuals
+        window.setflags(write=False)
+        peak = int(np.argmax(window))
+        impact = DetectedImpact(lane=0, sequence=0, start_index=pre, end_index=n - pre, peak_index=peak,
+                                peak_value=float(window[peak]), baseline=0.0, baseline_slope=0.0, noise=0.01,
+                                previous_end=None, next_start=None, clipped=False, truncated=False, overlong=False,
+                                window_start=0, window=window, emitted_at=n)
+        impact_indices(impact, rate)
+        second_pulse(impact)
+        fit = _shape_fit(impact, analysis)
+        if fit.get("converged") and fit.get("velocity_stderr") == 0.0:
+            at_velocity(fit, 1.0)
+        split_contact(t, window, 0.01, velocity=1.0)
+    _WARM.add(analysis.rate)
 
 
 def isolated(impact: DetectedImpact) -> DetectedImpact:
