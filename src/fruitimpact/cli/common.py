@@ -122,9 +122,11 @@ def _finite(obj):
     return obj
 
 
-def dump_json(obj) -> str:
-    """JSON with NaN/inf written as null (strict JSON)."""
-    return json.dumps(_finite(obj), indent=2, default=_json_default, allow_nan=False)
+def dump_json(obj, indent: int | None = 2) -> str:
+    """JSON with NaN/inf written as null (strict JSON); ``indent=None``: one compact line."""
+    separators = None if indent is not None else (",", ":")
+    return json.dumps(_finite(obj), indent=indent, separators=separators, default=_json_default, allow_nan=False,
+                      ensure_ascii=indent is not None)
 
 
 

@@ -26,7 +26,7 @@ def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: b
 
 
 def _json_line(obj) -> str:
-    return json.dumps(json.loads(dump_json(obj)), separators=(",", ":"), ensure_ascii=False)
+    return dump_json(obj, indent=None)
 
 
 def add_analysis_options(parser) -> None:
