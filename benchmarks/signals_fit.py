@@ -58,12 +58,12 @@ def scipy_table(row):
     from scipy.optimize import least_squares
 
     t, y = row["time"] - row["time"][0], row["force"]
-    model = fitmod._Model(np.ascontiguousarray(t))
+    model = fitmod.PulseModel(np.ascontiguousarray(t))
     start, _ = fitmod._start(t, y, model, None)
     sol = least_squares(lambda p: model(p) - y, start, jac=lambda p: model(p, True)[1],
                         bounds=([-np.inf, -np.inf, -np.inf, 0.0], [np.inf, np.inf, np.inf, fitmod.X_MAX]),
                         x_scale="jac", xtol=1e-10, ftol=1e-10)
-    return fitmod._derived(sol.x, row["velocity"], None, None, None)[0], sol.nfev
+    return fitmod.derived(sol.x, row["velocity"], None, None, None)[0], sol.nfev
 
 
 def scipy_exact(row):
@@ -71,9 +71,9 @@ def scipy_exact(row):
     from scipy.optimize import least_squares
 
     t, y, v = row["time"] - row["time"][0], row["force"], row["velocity"]
-    model = fitmod._Model(np.ascontiguousarray(t))
+    model = fitmod.PulseModel(np.ascontiguousarray(t))
     start, _ = fitmod._start(t, y, model, None)
-    derived = fitmod._derived(start, v, None, None, None)
+    derived = fitmod.derived(start, v, None, None, None)
     p0 = [start[0], math.log(derived[0]), math.log(derived[2]), start[3]]
 
     def residual(p):

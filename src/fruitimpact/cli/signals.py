@@ -57,11 +57,25 @@ def add_analysis_options(parser) -> None:
     sort.add_argument("--classes", metavar="NAMES", help="class names, softest first (default soft,medium,firm,...)")
 
 
-def analysis_from(args, rate: float):
-    """(DetectorSettings, Analysis) from the options, every value checked before any work."""
+#: The CLI option of each detector and analysis setting, so that their errors name what the user typed.
+_SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hum", "hum_q": "--hum",
+                    "lowpass_cutoff": "--lowpass", "clip_low": "--clip", "clip_high": "--clip",
+                    "max_flight": "--rebound-window", "pitch": "--pitch/--fruit-rate"}
+
+
+def _setting_error(exc: ValueError) -> UsageError:
+    """The library's error about a setting, prefixed with the option the user gave it by."""
+    text = str(exc)
+    option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
+    return UsageError(f"argument {option}: {text}" if option else text)
+
+
+def analysis_from(args, rate: float, rate_known: bool = True):
+    """(DetectorSettings, Analysis) from the options, every value checked before any work (those that depend
+    on the sample rate only when ``rate_known``)."""
     from ..constants import STANDARD_GRAVITY
     from ..signals.analysis import Analysis
-    from ..signals.detect import DetectorSettings
+    from ..signals.detect import Detector, DetectorSettings
     from ..signals.sort import FirmnessClasses
 
     hum = _float("--hum", args.hum, "frequency")
@@ -93,8 +107,10 @@ def analysis_from(args, rate: float):
             k_on=_float("--k-on", args.k_on, "dimensionless"), k_off=_float("--k-off", args.k_off, "dimensionless"),
             hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
             clip_low=clip[0], clip_high=clip[1])
+        if rate_known:
+            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
     except ValueError as exc:
-        raise UsageError(str(exc)) from None
+        raise _setting_error(exc) from None
     mass = _float("--mass", args.mass, "mass")
     diameter = _float("--diameter", args.diameter, "length")
     poisson = _float("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
@@ -117,7 +133,7 @@ def analysis_from(args, rate: float):
         analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,
                             poisson=poisson, classes=classes, max_flight=window, pitch=pitch)
     except ValueError as exc:
-        raise UsageError(str(exc)) from None
+        raise _setting_error(exc) from None
     return settings, analysis
 
 
@@ -188,7 +204,7 @@ def cmd_analyze(args) -> int:
             check_output(args.plot, "--plot", FIGURE_FORMATS)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
-    analysis_from(args, rate if rate is not None else 1e12)  # every option checked before the file is read
+    analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)  # every option checked before the file is read
     try:
         source = open_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
     except ValueError as exc:

@@ -66,6 +66,7 @@ from ..engine.powerlaw import (
     powerlaw_single,
 )
 
+# The public names; PulseModel, levenberg_marquardt, derived and named_result also serve split.py.
 __all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve", "prepare",
            "shape_table_error"]
 
@@ -199,7 +200,7 @@ def _pulse(t, t0, peak, duration, a, da, model, jacobian):
             jacobian[i, 3] = peak * hx
 
 
-class _Model:
+class PulseModel:
     """The tabulated pulse F(t; θ) on fixed sample times, plus an optional baseline polynomial
     b0 + b1 u (u = t scaled to [-1, 1] over the window) in θ[4:], with its Jacobian."""
 
@@ -236,7 +237,7 @@ class _Model:
 
 
 def _table_shape(x: float, sigma: np.ndarray) -> np.ndarray:
-    model = _Model(np.ascontiguousarray(sigma, dtype=float))
+    model = PulseModel(np.ascontiguousarray(sigma, dtype=float))
     return model((0.0, 0.0, 0.0, x))
 
 
@@ -302,7 +303,7 @@ def _noise_estimate(y: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
 
 
-def _start(t, y, model: _Model, weights) -> tuple[np.ndarray | None, str]:
+def _start(t, y, model: PulseModel, weights) -> tuple[np.ndarray | None, str]:
     """Starting θ: the smoothed peak, the half-maximum crossings, and for each x of a grid the
     t0 and T that put the model's half-maximum points on the measured ones; the x with the least
     squared residual wins (the baseline terms, if any, fitted to the samples outside the pulse)."""
@@ -338,7 +339,7 @@ def _start(t, y, model: _Model, weights) -> tuple[np.ndarray | None, str]:
 # ---------------------------------------------------------------------------------------------------------
 # Levenberg–Marquardt
 
-def _levenberg_marquardt(model: _Model, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,)):
+def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,)):
     """Minimise Σ (w (F(θ) − y))² over θ = (t0, ln F_max, ln T, x, baseline…) with each x (the entries
     ``bounded``) projected on [0, X_MAX].
     Marquardt's diagonal scaling, Nielsen's damping update.  Returns (θ, J at θ, residual, iterations,
@@ -418,7 +419,7 @@ def _levenberg_marquardt(model: _Model, y: np.ndarray, theta: np.ndarray, weight
 # ---------------------------------------------------------------------------------------------------------
 # From θ to the reported quantities
 
-def _derived(theta, velocity, mass, diameter, poisson) -> np.ndarray:
+def derived(theta, velocity, mass, diameter, poisson) -> np.ndarray:
     """The quantities of ``_FIT_NAMES`` (in that order) from θ, through the exact engine."""
     t0, log_peak, log_duration, x = theta
     peak, duration = math.exp(log_peak), math.exp(log_duration)
@@ -442,7 +443,7 @@ def _derived(theta, velocity, mass, diameter, poisson) -> np.ndarray:
 
 
 def _derived_stderr(theta, covariance, args) -> np.ndarray:
-    """Standard errors of ``_derived`` by the delta method (central differences in θ)."""
+    """Standard errors of ``derived`` by the delta method (central differences in θ)."""
     sd = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     floor = np.array([1e-9 * math.exp(theta[2]), 1e-9, 1e-9, 1e-9])
     steps = np.maximum(1e-4 * sd, floor)
@@ -455,10 +456,31 @@ def _derived_stderr(theta, covariance, args) -> np.ndarray:
             down[3] = theta[3]
         if i == 3 and up[3] > X_MAX:
             up[3] = theta[3]
-        columns.append((_derived(up, *args) - _derived(down, *args)) / (up[i] - down[i]))
+        columns.append((derived(up, *args) - derived(down, *args)) / (up[i] - down[i]))
     g = np.column_stack(columns)
     variance = np.einsum("qi,ij,qj->q", g, covariance, g)
     return np.sqrt(np.maximum(variance, 0.0))
+
+
+def named_result(theta, covariance, args, t_ref: float) -> dict:
+    """The fitted quantities and their standard errors by name, from one pulse's θ (4 values, its start
+    relative to ``t_ref`` [s]) and its 4×4 covariance; ``args`` = (velocity, mass, diameter, poisson) as
+    given to the fit (a given velocity or mass has standard error 0; no diameter, no modulus error)."""
+    velocity, mass, diameter, _ = args
+    values = derived(theta, *args)
+    errors = _derived_stderr(theta, covariance, args) if np.all(np.isfinite(covariance)) \
+        else np.full(values.shape, np.nan)
+    result = {}
+    for name, value, error in zip(_FIT_NAMES, values, errors):
+        result[name] = float(value)
+        result[name + "_stderr"] = float(error)
+    result["start_time"] += t_ref
+    for given, name in ((velocity, "velocity"), (mass, "mass")):
+        if given is not None:
+            result[name + "_stderr"] = 0.0
+    if diameter is None:
+        result["modulus_stderr"] = math.nan
+    return result
 
 
 def _empty_result(message: str) -> dict:
@@ -593,13 +615,13 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
         if at_max >= 3:
             notes.append(f"{at_max} samples equal the maximum: clipped? exclude them with mask=")
 
-    model = _Model(ts, terms)
+    model = PulseModel(ts, terms)
 
     theta, message = _start(ts, ys, model, weights)
     if theta is None:
         return _empty_result(message)
     with np.errstate(over="ignore", invalid="ignore"):  # a far trial step is rejected, not worth a warning
-        theta, jac, r, iterations, converged, message = _levenberg_marquardt(model, ys, theta, weights)
+        theta, jac, r, iterations, converged, message = levenberg_marquardt(model, ys, theta, weights)
 
     t0, duration, x = theta[0], math.exp(theta[2]), theta[3]
     inside = int(np.count_nonzero((ts > t0) & (ts < t0 + duration)))
@@ -633,21 +655,7 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
         noise_used = noise_level
     covariance = s2 * inverse
 
-    args = (velocity, mass, diameter, poisson)
-    theta = theta[:4]
-    values = _derived(theta, *args)
-    errors = _derived_stderr(theta, covariance, args) if np.all(np.isfinite(covariance)) \
-        else np.full(values.shape, np.nan)
-    result = {}
-    for name, value, error in zip(_FIT_NAMES, values, errors):
-        result[name] = float(value)
-        result[name + "_stderr"] = float(error)
-    result["start_time"] += t_ref
-    for given, name in ((velocity, "velocity"), (mass, "mass")):
-        if given is not None:
-            result[name + "_stderr"] = 0.0
-    if diameter is None:
-        result["modulus_stderr"] = math.nan
+    result = named_result(theta[:4], covariance, (velocity, mass, diameter, poisson), t_ref)
     result.update(fit_residual=rms, fit_residual_relative=rms / result["peak_force"], noise=noise_used,
                   samples_in_contact=inside, converged=bool(converged), iterations=int(iterations),
                   message="; ".join([message] + notes))

@@ -314,13 +314,20 @@ def second_pulse(impact: DetectedImpact) -> float:
     Two fruit landing within a fraction of a time to peak of each other make one unimodal pulse: they
     cannot be told from one heavier fruit this way."""
     w = np.asarray(impact.window, dtype=np.float64)
-    k = SECOND_PULSE_SMOOTHING
-    if w.shape[0] < 3 * k:
+    if w.shape[0] < 3 * SECOND_PULSE_SMOOTHING:
         return 0.0
-    s = np.convolve(w, np.full(k, 1.0 / k), mode="valid")
+    _, _, rise, fall = departure_from_one_peak(w)
+    return max(float(rise.max()), float(fall.max()))
+
+
+def departure_from_one_peak(force: np.ndarray) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
+    """(s, top, rise, fall) of a force window: ``s`` its moving average over ``SECOND_PULSE_SMOOTHING``
+    samples (``s[i]`` is centred on ``force[i + SECOND_PULSE_SMOOTHING // 2]``), ``top`` the index of its
+    maximum, ``rise[j]`` how far ``s[top + j]`` has risen above the lowest value since the top and ``fall[j]``
+    how far ``s[j]`` lies below the highest value before it (j ≤ top).  One pulse: both ≈ noise."""
+    k = SECOND_PULSE_SMOOTHING
+    s = np.convolve(force, np.full(k, 1.0 / k), mode="valid")
     top = int(np.argmax(s))
     after = s[top:]
-    rise = float(np.max(after - np.minimum.accumulate(after))) if after.size else 0.0
     before = s[:top + 1]
-    fall = float(np.max(np.maximum.accumulate(before) - before)) if before.size else 0.0
-    return max(rise, fall)
+    return s, top, after - np.minimum.accumulate(after), np.maximum.accumulate(before) - before

@@ -21,16 +21,8 @@ import math
 
 import numpy as np
 
-from .fit import (
-    MIN_PEAK_SNR,
-    RESULT_KEYS,
-    X_MAX,
-    _derived,
-    _derived_stderr,
-    _FIT_NAMES,
-    _levenberg_marquardt,
-    _Model,
-)
+from .fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, levenberg_marquardt, named_result
+from .indices import SECOND_PULSE_SMOOTHING, departure_from_one_peak
 
 __all__ = ["MISFIT_LIMIT", "split_contact"]
 
@@ -42,14 +34,13 @@ __all__ = ["MISFIT_LIMIT", "split_contact"]
 MISFIT_LIMIT = 0.018
 #: Ratio T/t_c of the starting guesses (a Hunt–Crossley pulse with e ≈ 0.6; the fit moves it).
 _DURATION_OVER_RISE = 3.2
-_SMOOTH = 5
 
 
 class _TwoPulses:
-    """F(t; θ_A) + F(t; θ_B) and its Jacobian, for ``_levenberg_marquardt``."""
+    """F(t; θ_A) + F(t; θ_B) and its Jacobian, for ``levenberg_marquardt``."""
 
     def __init__(self, t: np.ndarray):
-        self.first, self.second = _Model(t), _Model(t)
+        self.first, self.second = PulseModel(t), PulseModel(t)
 
     def __call__(self, theta, jacobian: bool = False):
         if not jacobian:
@@ -60,22 +51,19 @@ class _TwoPulses:
 
 
 def _landmarks(y: np.ndarray) -> tuple[int, int, int] | None:
-    """(first maximum, dip, second maximum) indices of the smoothed force, in time order."""
-    s = np.convolve(y, np.full(_SMOOTH, 1.0 / _SMOOTH), mode="same")
-    top = int(np.argmax(s))
-    after = s[top:]
-    rise = after - np.minimum.accumulate(after)
-    before = s[:top + 1]
-    fall = np.maximum.accumulate(before) - before
+    """(first maximum, dip, second maximum) indices of the force, in time order, from its smoothed
+    departure from one peak (``indices.departure_from_one_peak``, as ``second_pulse`` measures it)."""
+    s, top, rise, fall = departure_from_one_peak(y)
+    centre = SECOND_PULSE_SMOOTHING // 2  # s[i] is centred on y[i + centre]
     if rise.size and (not fall.size or rise.max() >= fall.max()):
         second = top + int(np.argmax(rise))
         dip = top + int(np.argmin(s[top:second + 1]))
-        return top, dip, second
+        return top + centre, dip + centre, second + centre
     if not fall.size or fall.max() <= 0:
         return None
     dip = int(np.argmax(fall))
     first = int(np.argmax(s[:dip + 1]))
-    return first, dip, top
+    return first + centre, dip + centre, top + centre
 
 
 def _onset(y: np.ndarray, end: int, level: float) -> int:
@@ -117,7 +105,7 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
     weights = np.full(ts.shape, 1.0 / noise)
     try:  # a trial step far out (a duration of e^700) is a failed separation, not an error
         with np.errstate(all="ignore"):
-            theta, jac, _, iterations, converged, _ = _levenberg_marquardt(model, y, theta, weights, bounded=(3, 7))
+            theta, jac, _, iterations, converged, _ = levenberg_marquardt(model, y, theta, weights, bounded=(3, 7))
     except (OverflowError, ValueError, np.linalg.LinAlgError):
         return None
     try:  # a degenerate pulse (a peak or duration beyond double precision) is a failed separation
@@ -139,23 +127,11 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
 
 def _parts(theta, covariance, args, t_ref, ts, rms, noise, iterations, model, y):
     """The two results and separated forces of a joint fit (``split_contact``)."""
-    velocity, mass, diameter, _ = args
     out = []
     for k, (lo, hi) in enumerate(((0, 4), (4, 8))):
         part = theta[lo:hi]
-        values = _derived(part, *args)
-        block = covariance[lo:hi, lo:hi]
-        errors = _derived_stderr(part, block, args) if np.all(np.isfinite(block)) else np.full(values.shape, np.nan)
         result = {name: math.nan for name in RESULT_KEYS}
-        for name, value, error in zip(_FIT_NAMES, values, errors):
-            result[name] = float(value)
-            result[name + "_stderr"] = float(error)
-        result["start_time"] += t_ref
-        for given, name in ((velocity, "velocity"), (mass, "mass")):
-            if given is not None:
-                result[name + "_stderr"] = 0.0
-        if diameter is None:
-            result["modulus_stderr"] = math.nan
+        result.update(named_result(part, covariance[lo:hi, lo:hi], args, t_ref))
         inside = int(np.count_nonzero((ts > part[0]) & (ts < part[0] + math.exp(part[2]))))
         if not all(math.isfinite(result[name]) for name in ("peak_force", "contact_duration", "restitution")):
             raise ValueError("a part without a finite peak, duration or restitution")
