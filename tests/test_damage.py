@@ -50,6 +50,19 @@ def test_safe_height_of_undamped_hertz_is_the_closed_form(criterion):
     assert result["sensitivity"]["mass"] == pytest.approx(-1.0, abs=1e-6)
 
 
+@pytest.mark.parametrize("model", ["tsuji", "kuwabara-kono"])
+def test_laws_with_a_hertz_elastic_part_answer_the_stress_criteria(model):
+    """Issue 14 item 7 (before: p0 = inf, bruised "-"): Tsuji and Kuwabara–Kono take p0 from their Hertz term
+    K δ^1.5.  Undamped they are Hertz's impact, so the onset is the closed form π⁴p⁵/(80 g ρ E*⁴) (to the
+    root finder's 1e-8); damped, the fruit is stopped at a smaller deflection, so the elastic p0 at a given
+    height is lower and the onset higher (a conservation argument: energy dissipated before δ_max)."""
+    undamped = safe_height(criterion="shear", model=model, failure_stress=3e5, restitution=1.0, **APPLE)
+    expected = _onset_height(3e5 / (2.0 * _tau_factor(0.37)), **APPLE)
+    assert undamped["safe_height"] == pytest.approx(expected, rel=1e-6)
+    damped = safe_height(criterion="shear", model=model, failure_stress=3e5, restitution=0.55, **APPLE)
+    assert math.isfinite(damped["safe_height"]) and damped["safe_height"] > 1.05 * expected
+
+
 def test_safe_height_does_not_depend_on_fruit_size_at_fixed_density():
     density = APPLE["mass"] / (math.pi * APPLE["diameter"] ** 3 / 6.0)
     heights = [safe_height(criterion="pressure", model="hertz", failure_stress=3e5, sensitivity=False,
@@ -200,6 +213,9 @@ def test_runs_accept_the_damage_inputs(cli, tmp_path):
     (("drop", "--drop-height", "10cm", "--surface", "fruit"), "--surface"),
     (("simulate", "--model", "tsuji", "--yield-pressure", "1MPa"), "--yield-pressure"),
     (("simulate", "--method", "rk4", "--yield-pressure", "1MPa"), "--method"),
+    # issue 14 item 7: a linear Kelvin–Voigt spring has no Hertz pressure, a stress criterion is refused
+    (("drop", "--model", "kelvin-voigt", "--criterion", "shear", "--drop-height", "10cm"), "--criterion"),
+    (("safe-height", "--model", "kelvin-voigt", "--criterion", "pressure"), "--criterion"),
 ])
 def test_bad_damage_inputs_are_one_line_errors(cli, argv, option):
     line = cli.error(*argv)

@@ -235,6 +235,16 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                          f"{family.formula}: give restitution, or damping ({family.damping_symbol} "
                          f"[{family.damping_unit}])", "alpha")
             in_model &= ~messages.flagged
+        if not family.pressure:
+            criteria = inputs.text["criterion"]
+            for code_c, name in enumerate(criteria.labels):
+                if name in ("pressure", "shear"):
+                    messages.set(in_model & (criteria.codes == code_c),
+                                 f"criterion {name} compares the Hertz contact pressure with the failure stress; "
+                                 f"model {model} is {family.formula}, a linear spring with no Hertz pressure: use "
+                                 f"--criterion energy, or a law with a Hertz elastic part (hunt-crossley, tsuji, "
+                                 f"kuwabara-kono, ...)", "criterion")
+            in_model &= ~messages.flagged
         if not family.first_integral and plastic.any():
             messages.set(in_model & plastic,
                          f"plastic contact (--yield-pressure, --bioyield-force) and cushion layers are built on the "

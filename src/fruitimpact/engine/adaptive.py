@@ -80,7 +80,7 @@ import numpy as np
 
 from .codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, KELVIN_VOIGT, KUWABARA_KONO, MAX_PRESSURE,
                     N_CHARACTERISTICS, POWER_LAW, TIME_TO_PEAK)
-from .forces import contact_force
+from .forces import contact_force, pressure_ratio
 from .powerlaw import PARALLEL_MIN_ROWS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
@@ -766,6 +766,7 @@ def _integrate(family, params, clamp, mass, velocity, radius, rtol, out,
                 peak_force *= force_ref
             else:
                 peak_force = touch_force
+            max_ratio = pressure_ratio(family, scaled, max_ratio, max_deflection)
             fill_characteristics(out, peak_force, time_to_peak * time_ref, t_end * time_ref,
                                  max_deflection * delta_ref, time_to_max * time_ref, -v_end * velocity,
                                  velocity, mass, max_ratio * (force_ref / delta_ref), radius)

@@ -40,3 +40,18 @@ def contact_force(family, params, deflection, rate, clamp):
     if clamp and force < 0.0:
         return 0.0
     return force
+
+
+@nb.njit(**_JIT)
+def pressure_ratio(family, params, max_ratio, max_deflection):
+    """The (F/δ)_max [N/m] that sets the peak Hertz contact pressure p_0 = 3 (F/δ)_max / (2π R) (a² = R δ;
+    Johnson 1985, eq 4.23), from the largest F/δ of the whole force seen over the contact (``max_ratio``)
+    and the largest deflection.  Power law: the whole force (Hunt–Crossley damping scales the Hertz force
+    by (1 + c δ̇), keeping its distribution).  Kuwabara–Kono and Tsuji: their Hertz elastic part K δ_max^0.5
+    alone (the dashpot, ∝ δ^0.5 δ̇ or δ^0.25 δ̇, has no Hertz distribution and makes F/a² unbounded at
+    first touch).  Kelvin–Voigt: NaN (a linear spring has no Hertz contact pressure)."""
+    if family == POWER_LAW:
+        return max_ratio
+    if family == KELVIN_VOIGT:
+        return math.nan
+    return params[0] * math.sqrt(max(max_deflection, 0.0))

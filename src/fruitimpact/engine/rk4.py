@@ -18,7 +18,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import contact_force
+from .forces import contact_force, pressure_ratio
 from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
@@ -122,7 +122,8 @@ def rk4_impact(family, params, clamp, mass, velocity, radius, step, max_steps, s
                 v_arr[k] = exit_rate
                 f_arr[k] = 0.0
             fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection, time_to_max,
-                                 -exit_rate, velocity, mass, max_ratio, radius)
+                                 -exit_rate, velocity, mass, pressure_ratio(family, params, max_ratio,
+                                                                            max_deflection), radius)
             return k + 1
         d = d_new
         v = v_new

@@ -110,6 +110,12 @@ class ForceFamily:
         The engine takes damping = factor × stiffness there (else the factor itself).
     elastic_stiffness : callable
         (m, k_c, v0) → the stiffness the force uses (k_c, or a matched linear k).
+    pressure : str
+        How the peak contact pressure p_0 = 3 (F/δ)_max / (2π R) (Hertz: a² = R δ) is read from the force:
+        ``"whole force"`` (the power law: Hunt–Crossley damping scales the Hertz force by (1 + c δ̇), so
+        the whole force has the Hertz distribution), ``"elastic part"`` (K δ_max^0.5 from the Hertz term
+        alone: a dashpot ∝ δ^0.5 δ̇ or δ^0.25 δ̇ has no Hertz distribution and would make F/a² unbounded at
+        first touch), or ``""`` (no Hertz part: no contact pressure, stress criteria refused).
     """
 
     code: int
@@ -128,6 +134,7 @@ class ForceFamily:
     damping_slot: int = 1
     damping_scaled: bool = False
     elastic_stiffness: Callable = _same_stiffness
+    pressure: str = "whole force"
 
     def params(self, stiffness, damping_factor, exponent: float = 1.5) -> np.ndarray:
         """Parameter matrix (rows, 3) of the engine's force (``engine.forces``): the stiffness,
@@ -156,15 +163,16 @@ KELVIN_VOIGT = ForceFamily(
     forces.KELVIN_VOIGT, "kelvin-voigt", "F = k δ + b δ̇", "k", "N/m", "b", "N·s/m", "s",
     alpha=False, first_integral=False, group_doc="ζ = b / (2 sqrt(k m))", to_group=_kv_group, from_group=_kv_factor,
     damping_scaled=True,  # b = c k
-    elastic_stiffness=hertz_equivalent_linear_stiffness)
+    elastic_stiffness=hertz_equivalent_linear_stiffness, pressure="")
 KUWABARA_KONO = ForceFamily(
     forces.KUWABARA_KONO, "kuwabara-kono", "F = K (δ^1.5 + B δ^0.5 δ̇)", "K", "N/m^1.5", "K·B", "N·s/m^1.5", "s",
     alpha=False, first_integral=False, group_doc="b = B (K/m)^(2/5) V_i^(1/5)",
-    to_group=_kk_group, from_group=_kk_factor)
+    to_group=_kk_group, from_group=_kk_factor, pressure="elastic part")
 TSUJI = ForceFamily(
     forces.TSUJI, "tsuji", "F = K δ^1.5 + η δ^0.25 δ̇", "K", "N/m^1.5", "η", "N·s/m^1.25", "s·m^0.25",
     alpha=False, first_integral=False, group_doc="α = η / sqrt(m K)",
-    to_group=_tsuji_group, from_group=_tsuji_factor, damping_scaled=True)  # η = c K
+    to_group=_tsuji_group, from_group=_tsuji_factor, damping_scaled=True,  # η = c K
+    pressure="elastic part")
 
 #: Families by engine code.
 FAMILIES: dict[int, ForceFamily] = {f.code: f for f in (POWER_LAW, KELVIN_VOIGT, KUWABARA_KONO, TSUJI)}
