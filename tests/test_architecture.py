@@ -50,7 +50,7 @@ def test_every_input_of_the_table_is_a_batch_column():
             value = "layer"
         result = evaluate({name: [value], **extra} if name != "bruise_energy" else {name: [value], **extra})
         if name in ("failure_stress", "bruise_susceptibility"):
-            result = evaluate({name: [value], "criterion": ["pressure"]})
+            result = evaluate({"failure_stress": [3e5], name: [value], "criterion": ["pressure"]})
         assert result.loc[0, "status"] == "ok", (name, result.loc[0, "message"])
 
 

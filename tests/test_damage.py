@@ -73,7 +73,7 @@ def test_safe_height_does_not_depend_on_fruit_size_at_fixed_density():
 
 def test_safe_height_ordered_by_surface():
     """Acceptance: steel ≤ wood < rubber belt < foam pad (the hard surfaces are rigid for Hertz)."""
-    heights = {s: safe_height(criterion="shear", surface=s, sensitivity=False)["safe_height"]
+    heights = {s: safe_height(criterion="shear", surface=s, failure_stress=3e5, sensitivity=False)["safe_height"]
                for s in ("steel", "wood", "rubber-belt", "foam-pad")}
     assert heights["steel"] <= heights["wood"] < heights["rubber-belt"] < heights["foam-pad"]
     assert heights["wood"] / heights["steel"] - 1 < 0.05  # wood across the grain: ~1 % softer contact
@@ -89,7 +89,7 @@ def test_safe_height_edges_are_said():
 
 
 def test_drop_energy_is_conserved_and_plastic_work_only_on_the_first_impact():
-    report = drop(0.1, yield_pressure=3e5, criterion="shear")
+    report = drop(0.1, yield_pressure=3e5, criterion="shear", failure_stress=3e5, bruise_susceptibility=4e-6)
     impacts = report["impacts"]
     mass = 0.115
     # the bookkeeping of the sequence: everything the fruit had at release is absorbed by the impacts or still in
@@ -117,7 +117,8 @@ def test_drop_refuses_a_free_partner_and_a_velocity():
 def test_line_incidence_is_the_batch_bruise_rate_of_the_same_members(tmp_path):
     rng = np.random.default_rng(3)
     rows = 400
-    members = {"mass": rng.normal(0.15, 0.02, rows), "modulus": rng.lognormal(np.log(3e6), 0.2, rows)}
+    members = {"mass": rng.normal(0.15, 0.02, rows), "modulus": rng.lognormal(np.log(3e6), 0.2, rows),
+               "failure_stress": np.full(rows, 3e5)}
     points = [TransferPoint("a", 0.02, "pvc-belt"), TransferPoint("b", 0.3, "foam-pad"),
               TransferPoint("c", 0.05, "steel", fruit_on_fruit=True)]
     report = audit(points, members, rows, "shear", {})
@@ -169,7 +170,8 @@ def test_simulate_json_has_the_damage_keys(cli):
 
 
 def test_drop_and_safe_height_json_contracts(cli):
-    report = cli.json("drop", "--drop-height", "10cm", "--yield-pressure", "0.3MPa", "--criterion", "pressure")
+    report = cli.json("drop", "--drop-height", "10cm", "--yield-pressure", "0.3MPa", "--criterion", "pressure",
+                      "--failure-stress", "0.3MPa")
     assert isinstance(report["impacts"], list) and report["impacts"]
     for key in ("velocity", "restitution", "peak_force", "plastic_work"):
         assert key in report["impacts"][0]
@@ -181,7 +183,7 @@ def test_drop_and_safe_height_json_contracts(cli):
 def test_runs_accept_the_damage_inputs(cli, tmp_path):
     table = tmp_path / "in.csv"
     table.write_text("drop_height,surface,yield_pressure,criterion,failure_stress\n"
-                     "10cm,steel,0.3MPa,shear,0.3MPa\n5cm,foam-pad,,pressure,\n")
+                     "10cm,steel,0.3MPa,shear,0.3MPa\n5cm,foam-pad,,pressure,0.3MPa\n")
     out = tmp_path / "out.csv"
     cli.ok("batch", table, "-o", out)
     import csv
@@ -190,9 +192,10 @@ def test_runs_accept_the_damage_inputs(cli, tmp_path):
         rows = list(csv.DictReader(handle))
     assert rows[0]["criterion"] == "shear" and float(rows[0]["plastic_work"]) > 0
     assert rows[1]["surface"] == "foam-pad" and rows[1]["status"] == "ok"
-    cli.ok("sweep", "--drop-height", "1cm:30cm:3", "--surface", "rubber-belt", "--criterion", "shear",
+    cli.ok("sweep", "--drop-height", "1cm:30cm:3", "--surface", "rubber-belt", "--criterion", "shear", "--fruit", "apple",
            "-o", tmp_path / "sweep.csv")
     summary = cli.json("population", "-n", "500", "--drop-height", "uniform(1cm,20cm)", "--criterion", "shear",
+                       "--failure-stress", "0.3MPa",
                        "--yield-pressure", "0.3MPa", "--characteristics", "bruised,bruise_volume")
     assert 0.0 < summary["statistics"]["bruised"]["mean"] <= 1.0  # the probability of bruising
 
@@ -249,7 +252,7 @@ def test_the_fruit_threshold_belongs_to_the_energy_criterion():
 
 
 def test_failed_rows_carry_no_damage_figures():
-    frame = batch.evaluate({"yield_pressure": [1e-300], "criterion": ["pressure"]})
+    frame = batch.evaluate({"yield_pressure": [1e-300], "criterion": ["pressure"], "failure_stress": [3e5]})
     assert frame.loc[0, "status"] == "failed"
     assert np.isnan(frame.loc[0, "bruised"]) and np.isnan(frame.loc[0, "plastic_work"])
 
@@ -257,7 +260,8 @@ def test_failed_rows_carry_no_damage_figures():
 def test_line_counts_invalid_fruit_and_uses_one_population(tmp_path, cli):
     line = tmp_path / "line.csv"
     line.write_bytes("\ufeffname,drop_height,surface\nA,20cm,steel\nB,5cm,pvc-belt\n".encode("utf-8"))  # a BOM
-    status, out, err = cli.run("line", line, "--criterion", "pressure", "-n", "500", "--mass", "normal(180g,200g)",
+    status, out, err = cli.run("line", line, "--criterion", "pressure", "--failure-stress", "0.3MPa", "-n", "500",
+                               "--mass", "normal(180g,200g)",
                                "--json")
     assert status == 0
     import json
@@ -269,6 +273,48 @@ def test_line_counts_invalid_fruit_and_uses_one_population(tmp_path, cli):
 
 
 def test_a_safe_height_that_cannot_be_found_is_not_a_result(cli):
-    status, out, err = cli.run("safe-height", "--criterion", "pressure", "--yield-pressure", "1e-300",
+    status, out, err = cli.run("safe-height", "--criterion", "pressure", "--failure-stress", "0.3MPa", "--yield-pressure", "1e-300",
                                "--no-sensitivity")
     assert status == 1 and "nan" not in out
+
+
+# ---------------------------------------------------------------- issue 14 item 1: no fruit borrows another's values
+def _library_value(fruit, key):
+    from fruitimpact.library import fruits
+
+    value = fruits()[fruit].inputs().get(key)
+    return math.nan if value is None else value
+
+
+@pytest.mark.parametrize("fruit", sorted(__import__("fruitimpact.library", fromlist=["fruits"]).fruits()))
+def test_each_fruit_uses_only_its_own_damage_values(fruit):
+    """The rule, checked on every library entry: a fruit's failure stress and bruise susceptibility are its own
+    library values; where its entry has none, a stress criterion is refused naming --failure-stress (before:
+    pear, peach and tomato borrowed the apple's 0.32 MPa), and the bruise volume is unknown (NaN, with a
+    warning), never another fruit's figure."""
+    stress = _library_value(fruit, "failure_stress")
+    frame = batch.evaluate({"fruit": [fruit], "criterion": ["shear"], "drop_height": [0.3]})
+    if math.isnan(stress):
+        assert frame.loc[0, "status"] == "invalid"
+        assert "failure_stress is not in the " + fruit in frame.loc[0, "message"]
+        assert "--failure-stress" in frame.loc[0, "message"]
+        frame = batch.evaluate({"fruit": [fruit], "criterion": ["shear"], "drop_height": [0.3],
+                                "failure_stress": [2e5]})
+        stress = 2e5
+    assert frame.loc[0, "status"] == "ok", frame.loc[0, "message"]
+    assert frame.loc[0, "failure_stress"] == stress
+    susceptibility = _library_value(fruit, "bruise_susceptibility")
+    if math.isnan(susceptibility):
+        assert math.isnan(frame.loc[0, "bruise_susceptibility"])
+        assert "bruise_susceptibility is not in the " + fruit in frame.loc[0, "warnings"]
+        assert frame.loc[0, "bruised"] == 0.0 or math.isnan(frame.loc[0, "bruise_volume"])
+    else:
+        assert frame.loc[0, "bruise_susceptibility"] == susceptibility
+
+
+def test_a_fruit_without_a_failure_stress_is_refused_on_the_command_line(cli):
+    line = cli.error("safe-height", "--fruit", "pear", "--criterion", "shear")
+    assert "--failure-stress" in line and "pear" in line
+    report = cli.json("safe-height", "--fruit", "pear", "--criterion", "shear", "--failure-stress", "0.2MPa",
+                      "--no-sensitivity")
+    assert report["status"] == "ok"

@@ -218,7 +218,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                                         thickness, radius), np.inf) if any_layer \
         else np.full(rows, np.inf)
     plastic = np.isfinite(yield_pressure) | layer
-    _check_damage_inputs(inputs, resolved, layer, used, thickness, messages)
+    _check_damage_inputs(inputs, resolved, layer, used, thickness, messages, warnings)
 
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
@@ -401,7 +401,8 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments, plastic_block)
 
 
-def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness, messages: MessageBook) -> None:
+def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness, messages: MessageBook,
+                         warnings: WarningBook) -> None:
     """Refusals that need the presets: layers without a usable thickness, bruise inputs without a
     criterion, an energy criterion without a threshold."""
     given = inputs.given
@@ -432,7 +433,22 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
                          "[J]; the --fruit's library entry has none)", "bruise_energy")
             messages.set(where & given["bruise_energy"] & ~(inputs.values["bruise_energy"] > 0.0) & ~messages.flagged,
                          "bruise_energy must be > 0 J for the energy criterion (its threshold)", "bruise_energy")
-        elif name == "shear":
+        if name in ("pressure", "shear"):
+            lacking = where & resolved.missing["failure_stress"] & ~given["failure_stress"] & ~messages.flagged
+            for fruit in sorted(set(resolved.fruit_of[lacking])):
+                messages.set(lacking & (resolved.fruit_of == fruit),
+                             f"failure_stress is not in the {fruit} entry of the fruit library (no sourced failure or "
+                             f"bioyield stress) and the {name} criterion needs it: give --failure-stress (the flesh's failure "
+                             f"stress [Pa], e.g. 0.3MPa, from a compression test of that fruit), or --criterion energy "
+                             f"with --bruise-energy", "failure_stress")
+        if name != "none":
+            lacking = where & resolved.missing["bruise_susceptibility"] & ~given["bruise_susceptibility"] \
+                & ~messages.flagged
+            for fruit in sorted(set(resolved.fruit_of[lacking])):
+                warnings.add(lacking & (resolved.fruit_of == fruit),
+                             f"bruise_susceptibility is not in the {fruit} entry of the fruit library: bruise onset is "
+                             f"judged, bruise volume is not (give --bruise-susceptibility [m^3/J], e.g. 3e-6)")
+        if name == "shear":
             poisson = used["poisson"]
             messages.set(where & ~((poisson >= 0.0) & (poisson <= 0.5)) & ~messages.flagged,
                          "poisson must be in [0, 0.5) for the shear criterion (Hertz's subsurface field)", "poisson")

@@ -19,9 +19,12 @@ from .quantities import INPUTS
 
 #: The library's names of fruit properties that differ from the inputs' names.
 _FRUIT_KEYS = {"bruise_threshold_energy": "bruise_energy"}
+_LIBRARY_KEYS = {value: key for key, value in _FRUIT_KEYS.items()}
 #: Surface models as codes.
 HALF_SPACE, LAYER = 0, 1
-#: Defaults of the damage inputs when neither the user nor the fruit gives one (docs/damage.md).
+#: Defaults of the damage inputs of a row without a ``--fruit`` (the paper's apple, docs/damage.md).  A row with
+#: a ``--fruit`` takes its damage values from that fruit's library entry only: one fruit never borrows another's
+#: (issue 14 item 1); what the entry lacks is in ``Resolved.missing`` and the criterion needing it is refused.
 DAMAGE_DEFAULTS = {
     "failure_stress": 0.32e6,  # apple flesh, Gorji Chakespari et al., Modern Applied Science (0.29-0.37 MPa)
     "bruise_susceptibility": 4.66e-6,  # apples, five cultivars 3.71-6.23 cm³/J (Int. J. Biosystems Eng.)
@@ -33,13 +36,17 @@ DAMAGE_DEFAULTS = {
 class Resolved:
     """The per-row defaults after presets: ``defaults`` (input name → a float for every row, or an
     array of one value per row; only the inputs that presets or damage defaults touch), the
-    surface model code per row, the default target restitution (float or per row), and the rows
-    whose ``bruise_energy`` comes from nobody (neither given nor in the fruit's library entry)."""
+    surface model code per row, the default target restitution (float or per row), the rows
+    whose ``bruise_energy`` comes from nobody (neither given nor in the fruit's library entry), and
+    ``missing``: for each damage input of ``DAMAGE_DEFAULTS``, the rows whose ``--fruit`` entry has no value
+    for it (NaN there unless the user gives one), with ``fruit_of`` the fruit name of each row ("" without)."""
 
     defaults: dict
     surface_model: np.ndarray
     restitution: np.ndarray | float
     no_threshold: np.ndarray
+    missing: dict
+    fruit_of: np.ndarray
 
     def apply(self, used: dict, given: dict) -> None:
         """Replace the table defaults in ``used`` (name → array) where the input was not given."""
@@ -74,6 +81,8 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     for name, value in DAMAGE_DEFAULTS.items():
         defaults[name] = value
     no_threshold = np.ones(rows, dtype=bool)
+    missing = {name: np.zeros(rows, dtype=bool) for name in DAMAGE_DEFAULTS}
+    fruit_of = np.full(rows, "", dtype=object)
     restitution = default_restitution
     fruit_labels = inputs.text["fruit"]
     fruits = library.fruits()
@@ -82,7 +91,13 @@ def resolve(inputs, default_restitution: float) -> Resolved:
         if name not in fruits:
             continue  # refused by the text check
         where = slice(None) if single else fruit_labels.codes == code
-        for key, value in fruits[name].inputs().items():
+        fruit_of[where] = name
+        entry = fruits[name].inputs()
+        for key in DAMAGE_DEFAULTS:
+            if key != "bruise_energy" and entry.get(_LIBRARY_KEYS.get(key, key)) is None:
+                defaults.put(key, where, math.nan, single)
+                missing[key][where] = True
+        for key, value in entry.items():
             key = _FRUIT_KEYS.get(key, key)
             if value is None:
                 continue
@@ -126,7 +141,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     for code, name in enumerate(model_labels.labels):
         if name in ("half-space", "layer"):
             surface_model[model_labels.codes == code] = LAYER if name == "layer" else HALF_SPACE
-    return Resolved(dict(defaults), surface_model, restitution, no_threshold)
+    return Resolved(dict(defaults), surface_model, restitution, no_threshold, missing, fruit_of)
 
 
 def effective_mass(mass, partner_mass):

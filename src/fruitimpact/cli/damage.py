@@ -70,7 +70,9 @@ def cmd_drop(args) -> int:
                   f"{volume:>9.4g}")
         print(f"absorbed {report['total_absorbed_energy'] * 1e3:.4g} mJ (plastic {report['total_plastic_work'] * 1e3:.4g}"
               f" mJ, viscous {report['total_viscous_work'] * 1e3:.4g} mJ)"
-              + ("" if report["bruise_volume"] is None else f"; bruise volume {report['bruise_volume'] * 1e9:.4g} mm³"))
+              + ("" if report["bruise_volume"] is None else
+                 "; bruise volume unknown (no bruise susceptibility)" if math.isnan(report["bruise_volume"]) else
+                 f"; bruise volume {report['bruise_volume'] * 1e9:.4g} mm³"))
         print(f"rule: {report['accumulation_rule']}")
         if report["status"] != "ok":
             print(f"{report['status'].upper()}: {report['message']}")

@@ -149,7 +149,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         "total_fruit_energy": float(sum(i["fruit_energy"] for i in impacts)),
         "energy_left": 0.5 * float(first.columns["mass"][0]) * impacts[-1]["exit_velocity"] ** 2,
         "bruised": None if criterion == "none" else any(bool(b) for b in bruised),
-        "bruise_volume": None if criterion == "none" else float(np.nansum(volumes)),
+        # a bruised impact without a volume (no bruise susceptibility) leaves the total unknown, never 0
+        "bruise_volume": None if criterion == "none" else
+        (math.nan if any(b and math.isnan(v) for b, v in zip(bruised, volumes)) else float(np.nansum(volumes))),
         "rest_time": rest, "status": status, "message": message, "warnings": warnings,
     }
 
