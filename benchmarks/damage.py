@@ -94,16 +94,17 @@ def damage_benchmarks(record, quick: bool) -> None:
     from fruitimpact.batch import evaluation
     from fruitimpact.damage.heights import safe_height
 
-    safe_height(criterion="shear", sensitivity=False)
-    search = best_of(lambda: safe_height(criterion="shear", sensitivity=False), 5)
-    one = best_of(lambda: evaluation({"criterion": ["shear"], "drop_height": [0.05]}), 5)
-    record("safe-height root search (shear, default apple)", search * 1e3, "one batch.evaluate of that row",
+    safe_height(criterion="shear", fruit="apple", sensitivity=False)
+    search = best_of(lambda: safe_height(criterion="shear", fruit="apple", sensitivity=False), 5)
+    one = best_of(lambda: evaluation({"criterion": ["shear"], "fruit": ["apple"], "drop_height": [0.05]}), 5)
+    record("safe-height root search (shear, library apple)", search * 1e3, "one batch.evaluate of that row",
            one * 1e3, "ms", "Illinois on ln h to 1e-9", of_baseline=True)
 
     from fruitimpact.damage.line import TransferPoint, audit
 
     n = 20_000 if quick else 200_000
-    members = {"mass": rng.normal(0.18, 0.02, n), "modulus": rng.lognormal(math.log(3e6), 0.15, n)}
+    members = {"mass": rng.normal(0.18, 0.02, n), "modulus": rng.lognormal(math.log(3e6), 0.15, n),
+               "fruit": np.full(n, "apple", dtype=object)}
     points = [TransferPoint("bin tipper", 0.3, "rubber-belt"), TransferPoint("conveyor", 0.05, "pvc-belt"),
               TransferPoint("singulator", 0.1, "steel"), TransferPoint("table", 0.08, "foam-pad", True),
               TransferPoint("carton", 0.15, "cardboard")]
