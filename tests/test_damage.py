@@ -247,7 +247,9 @@ def test_a_bad_energy_threshold_is_one_invalid_row_not_a_dead_batch(cli, tmp_pat
 def test_the_fruit_threshold_belongs_to_the_energy_criterion():
     """Before: the apple's 0.08 J threshold was subtracted under the pressure criterion: bruised, volume 0."""
     frame = batch.evaluate({"fruit": ["apple", "apple"], "criterion": ["pressure", "energy"], "drop_height": [0.3, 0.3]})
-    assert list(frame["bruise_energy"]) == [0.0, 0.08]
+    # the energy row subtracts the library's 0.08 J; the pressure row its own onset energy (not the 0.08 J)
+    assert frame.loc[1, "bruise_energy"] == 0.08
+    assert 0.0 < frame.loc[0, "bruise_energy"] < frame.loc[0, "fruit_energy"] and frame.loc[0, "bruise_energy"] != 0.08
     assert frame.loc[0, "bruised"] == 1.0 and frame.loc[0, "bruise_volume"] > 0.0
 
 
@@ -318,3 +320,21 @@ def test_a_fruit_without_a_failure_stress_is_refused_on_the_command_line(cli):
     report = cli.json("safe-height", "--fruit", "pear", "--criterion", "shear", "--failure-stress", "0.2MPa",
                       "--no-sensitivity")
     assert report["status"] == "ok"
+
+
+@pytest.mark.parametrize("criterion", ["pressure", "shear"])
+def test_bruise_volume_grows_from_zero_at_the_stress_onset(criterion):
+    """Issue 14 item 5b (before: W_th = 0 under the stress criteria, so the volume jumped from 0 to ~190 mm³ at
+    onset).  Published bruises grow as BS (W − W_th) above a threshold.  Reference: the onset height h_s of the
+    root search (an independent path: Illinois on ln h to 1e-9) and the energy of a drop at fixed e,
+    W_f = m g h (1 − e²); so above onset BV = BS m g (1 − e²)(h − h_s) exactly, and 0 just below it."""
+    hs = safe_height(criterion=criterion, fruit="apple", sensitivity=False)["safe_height"]
+    heights = [0.999 * hs, 1.001 * hs, 2.0 * hs, 10.0 * hs]
+    frame = batch.evaluate({"fruit": ["apple"] * 4, "criterion": [criterion] * 4, "drop_height": heights})
+    mass, e, bs = frame.loc[0, "mass"], frame.loc[0, "restitution"], frame.loc[0, "bruise_susceptibility"]
+    assert frame.loc[0, "bruised"] == 0.0 and frame.loc[0, "bruise_volume"] == 0.0
+    for k, h in enumerate(heights[1:], start=1):
+        expected = bs * mass * G * (1.0 - e ** 2) * (h - hs)
+        # 1e-6 relative: the root's 1e-9 in ln h is 1e-9·h_s in h, i.e. ≤ 1e-6 of (h − h_s) at 1.001 h_s
+        assert frame.loc[k, "bruise_volume"] == pytest.approx(expected, rel=1e-6)
+        assert frame.loc[k, "bruise_energy"] == pytest.approx(mass * G * (1.0 - e ** 2) * hs, rel=1e-8)

@@ -508,7 +508,6 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
     # the fruit's library threshold is the energy criterion's; the stress criteria subtract only a given one
     threshold = np.where((codes == CRITERION_NAMES.index("energy")) | inputs.given["bruise_energy"],
                          used["bruise_energy"], 0.0)
-    columns["bruise_energy"] = threshold
     columns.update(bruise_columns(codes, peak_pressure=out[:, COLUMN["max_pressure"]], poisson=used["poisson"],
                                   fruit_energy=columns["fruit_energy"], failure_stress=used["failure_stress"],
                                   threshold_energy=threshold, susceptibility=used["bruise_susceptibility"],

@@ -195,15 +195,16 @@ INPUTS: dict[str, Quantity] = _table(
              POSITIVE, Range(0.01, 1e4, True, True), None, "--bioyield-force"),
     Quantity("failure_stress", "σ_f", "failure stress σ_f", "modulus", "MPa", 1e-6,
              "failure (bioyield) stress of the flesh for the bruise criterion (needs --criterion; "
-             "default: the --fruit's, else 0.32 MPa, apple flesh)",
+             "default: the --fruit's own; a fruit without one refuses the stress criteria)",
              POSITIVE, Range(1e4, 5e6, True, True), None, "--failure-stress"),
     Quantity("bruise_susceptibility", "BS", "bruise susceptibility BS", "susceptibility", "cm³/J", 1e6,
-             "bruise volume per joule of absorbed energy above the threshold (default: the --fruit's, "
-             "else 4.6 cm³/J, apples)",
+             "bruise volume per joule of absorbed energy above the threshold (default: the --fruit's own; "
+             "without one the bruise volume is unknown)",
              NON_NEGATIVE, Range(1e-7, 5e-5, True, True), None, "--bruise-susceptibility"),
     Quantity("bruise_energy", "W_th", "bruise threshold energy W_th", "energy", "mJ", 1e3,
-             "absorbed energy at bruise onset: the energy criterion's threshold, subtracted from the "
-             "absorbed energy in the bruise volume (default: the --fruit's for the energy criterion, else 0 J)",
+             "absorbed energy at bruise onset, subtracted from the fruit's energy in the bruise volume: the "
+             "energy criterion's threshold (default: the --fruit's); under a stress criterion the fruit "
+             "energy at that criterion's own onset (an output)",
              NON_NEGATIVE, Range(0.0, 5.0, True, True), None, "--bruise-energy"),
     Quantity("step", "Δt", "RK4 step Δt", "time", "ms", 1e3, "RK4 time step (default 1e-4 s, the paper's)",
              POSITIVE, None, 1e-4, "--step"),

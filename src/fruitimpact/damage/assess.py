@@ -8,7 +8,15 @@ The rules (docs/damage.md):
   threshold (σ_f, σ_f/2 or W_th);
 * the bruise volume is BS (W_f − W_th)₊ where the criterion says bruised, 0
   elsewhere (Opara & Pathare 2014: BV = BS (E − E_th)₊), W_f being the fruit's
-  share of the absorbed energy ½ m* V² (1 − e²);
+  share of the absorbed energy ½ m* V² (1 − e²).  Under a stress criterion W_th
+  is the fruit energy at the criterion's own onset, so the volume grows from 0
+  there as published bruises do (issue 14 item 5b; before, it jumped from 0 to
+  ~190 mm³): at a fixed restitution the impact is the same dimensionless
+  impact at every speed (power law, Tsuji, Kuwabara–Kono: e fixes the damping
+  group), so p0 and τ_max go as V^0.4 (Hertz scales, δ ∝ V^0.8) and W_f as V²;
+  the onset energy is W_f (threshold/quantity)⁵ exactly.  On a cushion layer
+  or with plastic contact p0 does not scale so; there it is the same Hertz
+  estimate (docs/damage.md says so);
 * the bruise is a spherical cap of width 2a/1.4 (a the contact radius; pear data,
   Stropek & Gołacki 2020) holding that volume, which fixes its depth.
 """
@@ -25,12 +33,13 @@ CRITERION_NAMES = ("none", "pressure", "shear", "energy")
 
 def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energy, failure_stress,
                    threshold_energy, susceptibility, contact_radius, valid) -> dict[str, np.ndarray]:
-    """``max_shear_stress``, ``bruise_margin``, ``bruised``, ``bruise_volume``, ``bruise_depth`` and
-    ``bruise_width`` of every row (arrays of the table's length; NaN where no criterion applies or
+    """``max_shear_stress``, ``bruise_margin``, ``bruised``, ``bruise_volume``, ``bruise_depth``,
+    ``bruise_width`` and ``bruise_energy`` (the threshold W_th the volume used) of every row (arrays of the table's length; NaN where no criterion applies or
     the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``."""
     rows = criterion.shape[0]
     out = {name: np.full(rows, np.nan) for name in ("bruise_margin", "bruised", "bruise_volume", "bruise_depth",
                                                    "bruise_width")}
+    out["bruise_energy"] = np.array(threshold_energy, dtype=float, copy=True)
     # laws with a force at first touch (Kelvin–Voigt) have no finite Hertz pressure: no stress criterion there
     finite = valid & np.isfinite(peak_pressure) & np.isfinite(fruit_energy)
     shear_ok = finite & (poisson >= 0.0) & (poisson <= 0.5)
@@ -59,8 +68,13 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
         out["bruise_margin"][rows_of] = margin
         bruised = margin >= 0.0
         out["bruised"][rows_of] = bruised
-        volume = bruise.bruise_volume(fruit_energy[rows_of], susceptibility[rows_of], threshold_energy[rows_of],
-                                      bruised)
+        threshold = threshold_energy[rows_of]
+        if name != "energy":  # the fruit energy at the stress criterion's onset (module docstring)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                onset = fruit_energy[rows_of] * (1.0 + margin) ** -5.0
+            threshold = np.maximum(threshold, np.where(bruised, onset, 0.0))
+            out["bruise_energy"][rows_of] = threshold
+        volume = bruise.bruise_volume(fruit_energy[rows_of], susceptibility[rows_of], threshold, bruised)
         depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of])
         out["bruise_volume"][rows_of] = volume
         out["bruise_depth"][rows_of] = depth
