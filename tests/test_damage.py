@@ -326,15 +326,47 @@ def test_a_fruit_without_a_failure_stress_is_refused_on_the_command_line(cli):
 def test_bruise_volume_grows_from_zero_at_the_stress_onset(criterion):
     """Issue 14 item 5b (before: W_th = 0 under the stress criteria, so the volume jumped from 0 to ~190 mm³ at
     onset).  Published bruises grow as BS (W − W_th) above a threshold.  Reference: the onset height h_s of the
-    root search (an independent path: Illinois on ln h to 1e-9) and the energy of a drop at fixed e,
-    W_f = m g h (1 − e²); so above onset BV = BS m g (1 − e²)(h − h_s) exactly, and 0 just below it."""
+    root search (an independent path: Illinois on ln h to 1e-9) and the energy of a drop at fixed e on the
+    basis the apple's susceptibility was measured on (impact, ½ m V² = m g h; absorbed would add (1 − e²)); so
+    above onset BV = BS m g (h − h_s) exactly, and 0 just below it."""
+    from fruitimpact.library import fruits
+
+    assert fruits()["apple"].bases() == {"bruise_susceptibility": "impact", "bruise_threshold_energy": "impact"}
     hs = safe_height(criterion=criterion, fruit="apple", sensitivity=False)["safe_height"]
     heights = [0.999 * hs, 1.001 * hs, 2.0 * hs, 10.0 * hs]
     frame = batch.evaluate({"fruit": ["apple"] * 4, "criterion": [criterion] * 4, "drop_height": heights})
-    mass, e, bs = frame.loc[0, "mass"], frame.loc[0, "restitution"], frame.loc[0, "bruise_susceptibility"]
+    mass, bs = frame.loc[0, "mass"], frame.loc[0, "bruise_susceptibility"]
     assert frame.loc[0, "bruised"] == 0.0 and frame.loc[0, "bruise_volume"] == 0.0
     for k, h in enumerate(heights[1:], start=1):
-        expected = bs * mass * G * (1.0 - e ** 2) * (h - hs)
+        expected = bs * mass * G * (h - hs)
         # 1e-6 relative: the root's 1e-9 in ln h is 1e-9·h_s in h, i.e. ≤ 1e-6 of (h − h_s) at 1.001 h_s
         assert frame.loc[k, "bruise_volume"] == pytest.approx(expected, rel=1e-6)
-        assert frame.loc[k, "bruise_energy"] == pytest.approx(mass * G * (1.0 - e ** 2) * hs, rel=1e-8)
+        assert frame.loc[k, "bruise_energy"] == pytest.approx(mass * G * hs, rel=1e-8)
+
+
+def test_each_bruise_value_is_applied_on_the_energy_its_source_measured():
+    """Issue 14 item 5a: published susceptibilities and thresholds are per impact energy in pendulum studies
+    (the library's apple: Khorasan cultivars, 'Royal Gala'), per absorbed energy elsewhere; each is applied on
+    its own basis (before: always on the absorbed energy, ~30 % low volumes and ~44 % high energy onsets at
+    e = 0.55).  Reference: the energies of a drop at fixed e, ½ m V² = m g h and ½ m V² (1 − e²)."""
+    h = 0.1
+    frame = batch.evaluate({"criterion": ["energy"] * 3, "drop_height": [h] * 3, "fruit": ["apple"] * 3,
+                            "bruise_energy": [None, 0.05, 0.05], "bruise_susceptibility": [None, 5e-6, 5e-6],
+                            "bruise_basis": ["absorbed", "absorbed", "impact"]})
+    mass, e = frame.loc[0, "mass"], frame.loc[0, "restitution"]
+    impact, absorbed = mass * G * h, mass * G * h * (1.0 - e ** 2)
+    assert frame.loc[0, "bruise_volume"] == pytest.approx(4.66e-6 * (impact - 0.08), rel=1e-9)  # library: impact
+    assert frame.loc[1, "bruise_volume"] == pytest.approx(5e-6 * (absorbed - 0.05), rel=1e-9)   # given, absorbed
+    assert frame.loc[2, "bruise_volume"] == pytest.approx(5e-6 * (impact - 0.05), rel=1e-9)     # given, impact
+    # a threshold on another basis than the susceptibility: carried over by this impact's ratio (1 − e²)
+    mixed = batch.evaluate({"criterion": ["energy"], "drop_height": [h], "fruit": ["pear"], "bruise_energy": [0.05],
+                            "bruise_basis": ["impact"]})
+    m, ee = mixed.loc[0, "mass"], mixed.loc[0, "restitution"]
+    assert fruits_basis("pear") == "absorbed"
+    assert mixed.loc[0, "bruise_volume"] == pytest.approx(3e-6 * (m * G * h - 0.05) * (1.0 - ee ** 2), rel=1e-9)
+
+
+def fruits_basis(name):
+    from fruitimpact.library import fruits
+
+    return fruits()[name].bases()["bruise_susceptibility"]

@@ -501,6 +501,13 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
         for name in ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work"):
             columns[name] = np.where(ok, columns[name], np.nan)
         columns["fruit_energy"] = np.where(ok, absorbed * share, np.nan)
+    # each bruise value on the energy its source measured it on (issue 14 item 5a): the fruit's share of the
+    # impact energy ½ m V² or of the absorbed energy; a threshold on another basis than the susceptibility is
+    # carried over by this impact's own ratio of the two
+    impact_share = np.where(ok, 0.5 * mass * velocity ** 2 * share, np.nan)
+    basis = resolved.impact_basis
+    threshold_energy = np.where(basis["bruise_energy"], impact_share, columns["fruit_energy"])
+    volume_energy = np.where(basis["bruise_susceptibility"], impact_share, columns["fruit_energy"])
     criterion = inputs.text["criterion"]
     codes = np.asarray([CRITERION_NAMES.index(label) if label in CRITERION_NAMES else 0
                         for label in criterion.labels], dtype=np.int8)[criterion.codes] \
@@ -509,8 +516,9 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
     threshold = np.where((codes == CRITERION_NAMES.index("energy")) | inputs.given["bruise_energy"],
                          used["bruise_energy"], 0.0)
     columns.update(bruise_columns(codes, peak_pressure=out[:, COLUMN["max_pressure"]], poisson=used["poisson"],
-                                  fruit_energy=columns["fruit_energy"], failure_stress=used["failure_stress"],
-                                  threshold_energy=threshold, susceptibility=used["bruise_susceptibility"],
+                                  fruit_energy=threshold_energy, volume_energy=volume_energy,
+                                  failure_stress=used["failure_stress"], threshold_energy=threshold,
+                                  susceptibility=used["bruise_susceptibility"],
                                   contact_radius=out[:, CONTACT_RADIUS], valid=done))
     return {name: columns[name] for name in (*DAMAGE_NAMES, "bruise_energy")}
 

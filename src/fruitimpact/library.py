@@ -35,7 +35,7 @@ from dataclasses import dataclass, fields
 from importlib import resources
 from types import MappingProxyType
 
-__all__ = ["FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit", "LibraryError", "Surface", "Value",
+__all__ = ["ENERGY_BASED", "ENERGY_BASES", "FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit", "LibraryError", "Surface", "Value",
            "fruit", "fruit_rows", "fruits", "surface", "surface_rows", "surfaces"]
 
 #: The numeric fields of a fruit and their SI units.
@@ -50,6 +50,9 @@ SURFACE_UNITS = {"modulus": "Pa", "poisson": "", "thickness": "m", "radius": "m"
 SURFACE_MODELS = ("half-space", "layer", "fruit")
 
 _FRUIT_REQUIRED = ("mass", "diameter", "modulus", "poisson")
+#: Bruise values defined per joule or in joules, and the energies a source can have measured them on.
+ENERGY_BASED = ("bruise_susceptibility", "bruise_threshold_energy")
+ENERGY_BASES = ("impact", "absorbed")
 _POSITIVE = {"mass", "diameter", "density", "modulus", "failure_stress", "alpha", "bruise_susceptibility",
              "bruise_threshold_energy", "thickness", "radius"}
 
@@ -76,6 +79,9 @@ class Value:
         ``True``: read in ``source`` or derived from read values; ``False``: not checked in a source.
     note : str
         What the value is and what it rests on; never empty when not confirmed.
+    basis : str
+        For an energy-based bruise value (``ENERGY_BASED``): the energy its source measured it on,
+        ``"impact"`` (½ m V², e.g. a pendulum's) or ``"absorbed"`` (½ m V² (1 − e²)); else ``""``.
     """
 
     value: float
@@ -85,6 +91,7 @@ class Value:
     source: str
     confirmed: bool
     note: str = ""
+    basis: str = ""
 
     @property
     def derived(self) -> bool:
@@ -156,6 +163,10 @@ class Fruit:
         names = ("mass", "diameter", "modulus", "poisson", "failure_stress", "bruise_susceptibility",
                  "bruise_threshold_energy", "restitution")
         return {name: getattr(self, name).value for name in names if getattr(self, name) is not None}
+
+    def bases(self) -> dict[str, str]:
+        """The energy basis (``"impact"`` or ``"absorbed"``) of each known energy-based bruise value."""
+        return {name: getattr(self, name).basis for name in ENERGY_BASED if getattr(self, name) is not None}
 
 
 @dataclass(frozen=True)
@@ -266,7 +277,13 @@ def _value(row: dict[str, str], name: str, unit: str, where: str) -> Value | Non
         raise LibraryError(f"{where} must lie in (-1, 0.5); its range is [{low:g}, {high:g}]")
     if name in ("restitution", "poisson") and math.isinf(high):
         raise LibraryError(f"{where} must be finite")
-    return Value(value, low, high, unit, source, confirmed == "true", note)
+    basis = ""
+    if name in ENERGY_BASED:
+        basis = (row.get(f"{name}_basis") or "").strip()
+        if basis not in ENERGY_BASES:
+            raise LibraryError(f"{where}_basis must be one of {', '.join(ENERGY_BASES)} (the energy the source "
+                               f"measured it on); got {basis!r}")
+    return Value(value, low, high, unit, source, confirmed == "true", note, basis)
 
 
 def _common(row: dict[str, str], kind: str, number: int, names: set[str]) -> tuple[str, str]:

@@ -39,7 +39,10 @@ class Resolved:
     surface model code per row, the default target restitution (float or per row), the rows
     whose ``bruise_energy`` comes from nobody (neither given nor in the fruit's library entry), and
     ``missing``: for each damage input of ``DAMAGE_DEFAULTS``, the rows whose ``--fruit`` entry has no value
-    for it (NaN there unless the user gives one), with ``fruit_of`` the fruit name of each row ("" without)."""
+    for it (NaN there unless the user gives one), with ``fruit_of`` the fruit name of each row ("" without);
+    ``impact_basis``: for ``bruise_susceptibility`` and ``bruise_energy``, the rows whose value is on the
+    impact-energy basis (the user's ``bruise_basis`` for a value given, the library's for the fruit's own;
+    else absorbed)."""
 
     defaults: dict
     surface_model: np.ndarray
@@ -47,6 +50,7 @@ class Resolved:
     no_threshold: np.ndarray
     missing: dict
     fruit_of: np.ndarray
+    impact_basis: dict
 
     def apply(self, used: dict, given: dict) -> None:
         """Replace the table defaults in ``used`` (name → array) where the input was not given."""
@@ -82,6 +86,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
         defaults[name] = value
     no_threshold = np.ones(rows, dtype=bool)
     missing = {name: np.zeros(rows, dtype=bool) for name in DAMAGE_DEFAULTS}
+    impact_basis = {name: np.zeros(rows, dtype=bool) for name in ("bruise_susceptibility", "bruise_energy")}
     fruit_of = np.full(rows, "", dtype=object)
     restitution = default_restitution
     fruit_labels = inputs.text["fruit"]
@@ -97,6 +102,8 @@ def resolve(inputs, default_restitution: float) -> Resolved:
             if key != "bruise_energy" and entry.get(_LIBRARY_KEYS.get(key, key)) is None:
                 defaults.put(key, where, math.nan, single)
                 missing[key][where] = True
+        for key, basis in fruits[name].bases().items():
+            impact_basis[_FRUIT_KEYS.get(key, key)][where] = basis == "impact"
         for key, value in entry.items():
             key = _FRUIT_KEYS.get(key, key)
             if value is None:
@@ -112,6 +119,13 @@ def resolve(inputs, default_restitution: float) -> Resolved:
             defaults.put(key, where, value, single)
             if key == "bruise_energy":
                 no_threshold[where] = False
+
+    basis_labels = inputs.text["bruise_basis"]
+    for code, label in enumerate(basis_labels.labels):
+        rows_of = basis_labels.codes == code
+        for key, flags in impact_basis.items():
+            given_here = rows_of & inputs.given[key]
+            flags[given_here] = label == "impact"
 
     def used(name):
         value = defaults.get(name, INPUTS[name].default)
@@ -141,7 +155,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     for code, name in enumerate(model_labels.labels):
         if name in ("half-space", "layer"):
             surface_model[model_labels.codes == code] = LAYER if name == "layer" else HALF_SPACE
-    return Resolved(dict(defaults), surface_model, restitution, no_threshold, missing, fruit_of)
+    return Resolved(dict(defaults), surface_model, restitution, no_threshold, missing, fruit_of, impact_basis)
 
 
 def effective_mass(mass, partner_mass):

@@ -232,6 +232,11 @@ INPUTS: dict[str, Quantity] = _table(
              "bruise onset: pressure (p_0 >= σ_f), shear (τ_max >= σ_f/2) or energy (W >= W_th); none: no "
              "bruise assessment",
              default="none", option="--criterion", choices="criterion"),
+    Quantity("bruise_basis", "", "energy basis of the given bruise values", "text", "", 1.0,
+             "the energy a given --bruise-susceptibility and --bruise-energy were measured on: absorbed "
+             "(½ m V² (1 − e²), the fruit's share) or impact (½ m V², the fruit's share; e.g. a pendulum's "
+             "energy); the library's values carry their own (fruitimpact fruits)",
+             default="absorbed", option="--bruise-basis", choices="bruise_basis"),
 )
 
 #: Inputs given in several ways: at most one of each group (the first is the default way).

@@ -28,8 +28,14 @@ CRITERION_CHOICES = MappingProxyType({
     "energy": "energy absorbed by the fruit >= threshold W_th",
 })
 
+#: ``--bruise-basis``: the energy a given bruise susceptibility and threshold energy were measured on.
+BRUISE_BASES = MappingProxyType({
+    "absorbed": "the energy the fruit absorbs, ½ m V² (1 − e²) (its share on a compliant surface)",
+    "impact": "the impact energy ½ m V² (its share on a compliant surface), as in pendulum studies",
+})
+
 REGISTRIES = {"model": DAMPING_LAWS, "calibration": CALIBRATIONS, "method": SOLVERS,
               "fruit": library.fruits(), "surface": SURFACE_CHOICES, "surface_model": SURFACE_MODELS,
-              "criterion": CRITERION_CHOICES}
+              "criterion": CRITERION_CHOICES, "bruise_basis": BRUISE_BASES}
 
-__all__ = ["CRITERION_CHOICES", "REGISTRIES", "SURFACE_CHOICES", "SURFACE_MODELS"]
+__all__ = ["BRUISE_BASES", "CRITERION_CHOICES", "REGISTRIES", "SURFACE_CHOICES", "SURFACE_MODELS"]

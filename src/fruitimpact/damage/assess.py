@@ -32,10 +32,16 @@ CRITERION_NAMES = ("none", "pressure", "shear", "energy")
 
 
 def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energy, failure_stress,
-                   threshold_energy, susceptibility, contact_radius, valid) -> dict[str, np.ndarray]:
+                   threshold_energy, susceptibility, contact_radius, valid, volume_energy=None) -> dict[str, np.ndarray]:
     """``max_shear_stress``, ``bruise_margin``, ``bruised``, ``bruise_volume``, ``bruise_depth``,
     ``bruise_width`` and ``bruise_energy`` (the threshold W_th the volume used) of every row (arrays of the table's length; NaN where no criterion applies or
-    the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``."""
+    the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``.  ``fruit_energy`` [J] is
+    the energy on the basis of ``threshold_energy`` (the energy criterion compares them), ``volume_energy``
+    [J] the energy on the basis of ``susceptibility`` (default: the same); the threshold is carried over to
+    the susceptibility's basis by their ratio for the volume.  The ``bruise_energy`` output is on the
+    threshold's basis."""
+    if volume_energy is None:
+        volume_energy = fruit_energy
     rows = criterion.shape[0]
     out = {name: np.full(rows, np.nan) for name in ("bruise_margin", "bruised", "bruise_volume", "bruise_depth",
                                                    "bruise_width")}
@@ -74,7 +80,11 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
                 onset = fruit_energy[rows_of] * (1.0 + margin) ** -5.0
             threshold = np.maximum(threshold, np.where(bruised, onset, 0.0))
             out["bruise_energy"][rows_of] = threshold
-        volume = bruise.bruise_volume(fruit_energy[rows_of], susceptibility[rows_of], threshold, bruised)
+        energy = volume_energy[rows_of]
+        if volume_energy is not fruit_energy:  # the threshold on the susceptibility's basis
+            with np.errstate(divide="ignore", invalid="ignore"):
+                threshold = np.where(threshold > 0.0, threshold * energy / fruit_energy[rows_of], 0.0)
+        volume = bruise.bruise_volume(energy, susceptibility[rows_of], threshold, bruised)
         depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of])
         out["bruise_volume"][rows_of] = volume
         out["bruise_depth"][rows_of] = depth
