@@ -370,3 +370,40 @@ def fruits_basis(name):
     from fruitimpact.library import fruits
 
     return fruits()[name].bases()["bruise_susceptibility"]
+
+
+def test_a_drop_keeps_the_fruit_damping_and_e_follows_the_law():
+    """Issue 14 item 6: the damping factor c = λ/k_c is calibrated once, at the first impact, and kept, so
+    each later e is the Hunt–Crossley law's at its own speed.  Reference: SciPy DOP853 (rtol 1e-11) of
+    m δ̈ = −k_c δ^1.5 (1 + c δ̇) with that c at each later speed, e = exit/entry speed (tolerance 1e-6: the
+    event location on the dense output, ~1e-9, and the engine's exact quadrature, ~1e-12).  The constant rule
+    keeps e fixed; the material rule gives e rising as the fruit slows, as drop tests report."""
+    from scipy.integrate import solve_ivp
+
+    from fruitimpact import batch as batch_module
+
+    report = drop(0.3, fruit="apple")
+    assert report["bounces"] == "material"
+    first = batch_module.evaluate({"fruit": ["apple"], "drop_height": [0.3]})
+    k, c, m = first.loc[0, "law_stiffness"], first.loc[0, "damping_factor"], first.loc[0, "mass"]
+
+    def restitution(v0):
+        def rhs(t, y):
+            d, v = y
+            return [v, -k * max(d, 0.0) ** 1.5 * (1.0 + c * v) / m]
+
+        def out(t, y):
+            return y[0]
+        out.terminal, out.direction = True, -1
+        sol = solve_ivp(rhs, (0.0, 1.0), [0.0, v0], method="DOP853", rtol=1e-11, atol=1e-15, events=out)
+        return -sol.y_events[0][0][1] / v0
+
+    impacts = report["impacts"]
+    assert impacts[0]["restitution"] == pytest.approx(0.55, rel=1e-9)
+    for impact in impacts[1:4]:
+        assert impact["restitution"] == pytest.approx(restitution(impact["velocity"]), rel=1e-6)
+    assert all(b["restitution"] > a["restitution"] for a, b in zip(impacts, impacts[1:]))
+    constant = drop(0.3, fruit="apple", bounces="constant")["impacts"]
+    assert all(i["restitution"] == pytest.approx(0.55, rel=1e-9) for i in constant)
+    with pytest.raises(ValueError, match="bounces must be one of"):
+        drop(0.3, bounces="elastic")

@@ -52,13 +52,13 @@ def cmd_drop(args) -> int:
         max_impacts = -1
     if not 1 <= max_impacts <= 1000:
         raise UsageError(f"argument --max-impacts: must be an integer in [1, 1000]; got {args.max_impacts!r}")
-    report = _library_call(drop, height, max_impacts=max_impacts, **kwargs)
+    report = _library_call(drop, height, max_impacts=max_impacts, bounces=args.bounces, **kwargs)
     _print_warnings("drop", report["warnings"])
     if args.json:
         print(dump_json(report))
     else:
         print(f"drop from {report['drop_height'] * 100:.4g} cm: {report['impact_count']} impacts, at rest after "
-              f"{report['rest_time']:.3g} s; criterion {report['criterion']}")
+              f"{report['rest_time']:.3g} s; criterion {report['criterion']}; bounces: {report['bounces']}")
         print(f"{'#':>3} {'V [m/s]':>9} {'e':>7} {'F_max [N]':>10} {'p_0 [MPa]':>10} {'W_p [mJ]':>9} "
               f"{'W_v [mJ]':>9} {'bruised':>8} {'BV [mm³]':>9}")
         for impact in report["impacts"]:
@@ -275,6 +275,10 @@ def add_parsers(sub) -> None:
                                     "velocity, its restitution from the model.")
     _add_impact_options(dr)
     dr.add_argument("--max-impacts", default="50", metavar="N", help="impacts followed at most (default 50)")
+    dr.add_argument("--bounces", default="material", choices=("material", "constant"),
+                    help="restitution of the later impacts: material (default: the damping calibrated at the "
+                         "first impact is kept, e rises as the fruit slows, as drop tests show) or constant "
+                         "(every impact at the same e)")
     dr.add_argument("--json", action="store_true", help="print one JSON object (SI)")
     dr.set_defaults(func=cmd_drop)
 

@@ -1,10 +1,18 @@
 """Drops: a fruit let fall from a height bounces on a surface until it rests.
 
-Each impact is a full impact of ``batch.evaluate`` at its own velocity, the
-restitution following from the model at that velocity (with plastic contact
-it falls as the velocity rises).  The rebound speed of one impact is the
-impact speed of the next, V_{n+1} = e_n V_n (no drag), after a flight of
-2 V_{n+1}/g.
+Each impact is a full impact of ``batch.evaluate`` at its own velocity.  The
+rebound speed of one impact is the impact speed of the next, V_{n+1} = e_n V_n
+(no drag), after a flight of 2 V_{n+1}/g.
+
+Restitution across bounces (``bounces``, issue 14 item 6).  A fruit's damping
+is a material property: by default (``"material"``) it is calibrated once, at
+the first impact, to the restitution asked for (or the fruit's), and each
+later impact keeps that damping factor c = λ/k (Hunt–Crossley's material
+constant; on a flattened spot with the stiffness of the new radius), so e
+follows the law at the lower speed: for the power law e is a function of
+x = c V alone and rises as the fruit slows, as drop tests show (Hunt &
+Crossley 1975: e = 1 − α V to first order; the founding paper's eq 6).
+``"constant"`` recalibrates every impact to the same e (the rule before).
 
 How repeated impacts on the same spot accumulate damage (the rule, stated in
 every output and in docs/damage.md): the fruit lands on the same spot every
@@ -42,7 +50,13 @@ _IMPACT_FIELDS = ("velocity", "restitution", "exit_velocity", "peak_force", "tim
                   "bruise_depth", "bruise_width")
 
 
-def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = REST_HEIGHT, **inputs) -> dict:
+#: ``bounces``: how the restitution of the later impacts follows (module docstring).
+BOUNCE_RULES = {"material": "damping calibrated at the first impact, kept: e follows the law as the fruit slows",
+                "constant": "every impact calibrated to the same restitution"}
+
+
+def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = REST_HEIGHT,
+         bounces: str = "material", **inputs) -> dict:
     """The sequence of impacts of a fruit dropped from ``drop_height`` [m] onto a surface.
 
     Parameters
@@ -53,6 +67,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         Impacts followed at most.
     rest_height : float
         The fruit rests once a rebound would rise less than this [m].
+    bounces : str
+        ``"material"`` (default: the damping calibrated at the first impact is kept, e rises as the fruit
+        slows) or ``"constant"`` (every impact at the same e); ``BOUNCE_RULES``.
     **inputs
         Any input of ``quantities.INPUTS`` but the velocity (fruit, surface, model,
         plastic and bruise inputs), as for ``simulate``.
@@ -78,6 +95,8 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     unknown = [name for name in inputs if name not in INPUTS]
     if unknown:
         raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
+    if bounces not in BOUNCE_RULES:
+        raise InputError(f"bounces must be one of {', '.join(BOUNCE_RULES)}; got {bounces!r}", "bounces")
     if not (isinstance(max_impacts, int) and 1 <= max_impacts <= 1000):
         raise InputError(f"max_impacts must be an integer in [1, 1000]; got {max_impacts!r}", "max_impacts")
     if inputs.get("surface") == "fruit":
@@ -98,6 +117,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     time = math.sqrt(2.0 * height / STANDARD_GRAVITY)
     result = first
     flattened = None
+    material_factor = float(first.columns["damping_factor"][0]) if "damping_factor" in first.columns else 0.0
+    if not math.isfinite(material_factor):
+        material_factor = 0.0
     while True:
         columns = {name: (float(result.columns[name][0])) for name in _IMPACT_FIELDS}
         code = int(result.status[0])
@@ -128,6 +150,12 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             next_row.pop("bioyield_force", None)
             next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
             next_row["diameter"] = 2.0 * flattened
+        if bounces == "material" and material_factor > 0.0:
+            # the first impact's damping factor c = λ/k, a property of the flesh: λ = c k of this contact
+            for name in ("restitution", "alpha", "damping"):
+                next_row.pop(name, None)
+            stiffness = next_row.get("stiffness", float(first.columns["law_stiffness"][0]))
+            next_row["damping"] = material_factor * float(stiffness)
         read, messages = read_columns({name: [value] for name, value in next_row.items()})
         result = evaluate_inputs(read, messages, detail=True)
         if result.status[0] == 3:
@@ -142,6 +170,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     bruised = [i["bruised"] for i in impacts]
     return {
         "drop_height": height, "criterion": criterion, "accumulation_rule": ACCUMULATION_RULE,
+        "bounces": bounces,
         "impacts": impacts, "impact_count": len(impacts),
         "total_absorbed_energy": float(sum(i["absorbed_energy"] for i in impacts)),
         "total_plastic_work": float(sum(i["plastic_work"] for i in impacts)),
@@ -160,4 +189,4 @@ def _contact_modulus(evaluation) -> float:
     return float(evaluation.kernel_arguments["contact_modulus"][0])
 
 
-__all__ = ["ACCUMULATION_RULE", "MAX_IMPACTS", "REST_HEIGHT", "drop"]
+__all__ = ["ACCUMULATION_RULE", "BOUNCE_RULES", "MAX_IMPACTS", "REST_HEIGHT", "drop"]
