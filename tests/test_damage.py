@@ -407,3 +407,52 @@ def test_a_drop_keeps_the_fruit_damping_and_e_follows_the_law():
     assert all(i["restitution"] == pytest.approx(0.55, rel=1e-9) for i in constant)
     with pytest.raises(ValueError, match="bounces must be one of"):
         drop(0.3, bounces="elastic")
+
+
+# ---------------------------------------------------------------- issue 14 item 4: a lot varies by default
+def test_a_population_draws_the_fruit_library_spreads_unless_fixed(cli, tmp_path):
+    """Before: `population --fruit apple` was N identical apples.  Now mass, modulus, failure stress and
+    susceptibility are drawn from the library ranges (normal about the value, sd = range/4, truncated to the
+    range) and the diameter follows the mass at the library density: every member satisfies
+    m = ρ π d³/6 exactly (float rounding), and each drawn input stays in its library range."""
+    from fruitimpact.library import fruits
+
+    apple = fruits()["apple"]
+    out = tmp_path / "members.csv"
+    cli.ok("population", "-n", "2000", "--fruit", "apple", "--drop-height", "4cm", "--criterion", "shear",
+           "-o", out)
+    import pandas as pd
+
+    frame = pd.read_csv(out)
+    for name in ("mass", "modulus", "failure_stress", "bruise_susceptibility"):
+        value = getattr(apple, name)
+        assert frame[name].std() > 0.1 * (value.high - value.low) / 4.0, name
+        assert frame[name].between(value.low, value.high).all(), name
+    density = apple.density.value
+    assert np.allclose(frame["mass"], density * np.pi * frame["diameter"] ** 3 / 6.0, rtol=1e-9)
+    # near onset (4 cm vs 3.3 cm for the central apple) incidence is a share, not 0 % or 100 %
+    assert 0.05 < frame["bruised"].mean() < 0.99
+    cli.ok("population", "-n", "200", "--fruit", "apple", "--mass", "150g", "--drop-height", "4cm",
+           "-o", tmp_path / "fixed.csv")
+    fixed = pd.read_csv(tmp_path / "fixed.csv")
+    assert (fixed["mass"] == 0.15).all() and fixed["modulus"].std() > 0
+    cli.ok("population", "-n", "200", "--fruit", "apple", "--no-spreads", "--drop-height", "4cm",
+           "-o", tmp_path / "same.csv")
+    same = pd.read_csv(tmp_path / "same.csv")
+    assert same["mass"].nunique() == 1 and same["modulus"].nunique() == 1
+
+
+def test_line_changes_are_the_audit_of_the_changed_line():
+    """The saving of a change of surface is paired (the same fruit): the line incidence with foam-pad at a
+    point equals the audit of the line with that point's surface replaced (an independent run)."""
+    rng = np.random.default_rng(5)
+    rows = 300
+    members = {"mass": rng.normal(0.18, 0.02, rows), "modulus": rng.lognormal(np.log(3e6), 0.2, rows),
+               "failure_stress": np.full(rows, 3e5)}
+    points = [TransferPoint("tipper", 0.1, "steel"), TransferPoint("belt", 0.04, "pvc-belt")]
+    report = audit(points, members, rows, "shear", {})
+    change = next(c for c in report["changes"] if c["point"] == "tipper" and c["to"] == "foam-pad")
+    changed = audit([TransferPoint("tipper", 0.1, "foam-pad"), points[1]], members, rows, "shear", {}, ())
+    assert change["incidence"] == pytest.approx(changed["incidence"], abs=1e-12)
+    assert change["incidence_saved"] == pytest.approx(report["incidence"] - changed["incidence"], abs=1e-12)
+    assert change["mean_bruise_volume"] == pytest.approx(changed["mean_bruise_volume"], rel=1e-12)

@@ -94,8 +94,9 @@ def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, 
     for folder in (same_name, other):
         folder.mkdir()
         (folder / "data.bin").write_text("someone else's")
-    cli.ok("population", "-n", 100, "--seed", 1)  # another job: its own folder
-    line = cli.error("population", "-n", 100, "--fresh")  # our job's name, not our folder
+    # --no-spreads: the job of PopulationSource((), (), 100, 0), whose folder name the test took
+    cli.ok("population", "-n", 100, "--seed", 1, "--no-spreads")  # another job: its own folder
+    line = cli.error("population", "-n", 100, "--fresh", "--no-spreads")  # our job's name, not our folder
     assert "not fruitimpact's" in line
     assert (same_name / "data.bin").exists() and (other / "data.bin").exists()
 

@@ -158,6 +158,57 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     return Resolved(dict(defaults), surface_model, restitution, no_threshold, missing, fruit_of, impact_basis)
 
 
+#: The properties a lot draws from its fruit's library spreads (issue 14 item 4), in this order; the
+#: diameter follows the mass at the fruit's density where the library has one.
+LOT_SPREADS = ("mass", "diameter", "modulus", "failure_stress", "bruise_susceptibility")
+
+
+@dataclass(frozen=True)
+class LotSpreads:
+    """What a lot of ``fruit`` varies by default: ``distributions`` ((input name, distribution) pairs:
+    each a normal about the library's value with sd = (high − low)/4, truncated to [low, high], the range
+    read as a ±2 sd band), ``diameter_density`` (the density [kg/m³] the diameter follows the mass at, or
+    None) and ``described``: one line per property varied or left fixed, for the output."""
+
+    fruit: str
+    distributions: tuple
+    diameter_density: float | None
+    described: tuple
+
+
+def lot_spreads(fruit: str, fixed) -> LotSpreads:
+    """The library spreads a lot of ``fruit`` is drawn from, leaving out the inputs in ``fixed`` (those the
+    user gave, as constants or distributions).  A property whose library range is one value (low = high)
+    stays that value; one the entry lacks is left to the inputs' own rules (a criterion needing it is
+    refused)."""
+    from .distributions import TruncNormal
+
+    entry = library.fruits()[fruit]
+    fixed = set(fixed)
+    out, lines, density = [], [], None
+    for name in LOT_SPREADS:
+        value = getattr(entry, name)
+        if name in fixed:
+            lines.append(f"{name}: as given")
+            continue
+        if value is None:
+            continue
+        if name == "diameter" and "mass" not in fixed and entry.density is not None \
+                and any(n == "mass" for n, _ in out):
+            density = entry.density.value
+            lines.append(f"diameter: from each fruit's mass at the {fruit} density {density:g} kg/m³ "
+                         f"(d = (6 m/(π ρ))^(1/3))")
+            continue
+        if not value.low < value.high:
+            lines.append(f"{name}: {value.value:g} {value.unit} (the library gives no spread)")
+            continue
+        sd = (value.high - value.low) / 4.0
+        out.append((name, TruncNormal(value.value, sd, value.low, value.high)))
+        lines.append(f"{name}: normal({value.value:g}, sd {sd:.3g}) in [{value.low:g}, {value.high:g}] {value.unit} "
+                     f"(the {fruit} library range as ±2 sd)")
+    return LotSpreads(fruit, tuple(out), density, tuple(lines))
+
+
 def effective_mass(mass, partner_mass):
     """Reduced mass m m_2/(m + m_2) [kg]; a fixed surface (m_2 = inf) leaves m."""
     mass = np.asarray(mass, dtype=float)
@@ -166,5 +217,6 @@ def effective_mass(mass, partner_mass):
         return np.where(np.isinf(partner_mass), mass, mass * partner_mass / (mass + partner_mass))
 
 
-__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "Resolved", "effective_mass", "resolve"]
+__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
+           "lot_spreads", "resolve"]
 assert all(name in INPUTS for name in DAMAGE_DEFAULTS) and math.isfinite(DAMAGE_DEFAULTS["failure_stress"])

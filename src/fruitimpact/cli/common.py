@@ -214,3 +214,32 @@ def _numba_without_blas() -> None:
     finally:
         del sys.modules["scipy.linalg.cython_blas"]
 
+
+
+# --------------------------------------------------------------------------------------------- lots
+def add_spread_option(parser) -> None:
+    """``--no-spreads``: every member at the fruit's central values (identical fruit)."""
+    parser.add_argument("--no-spreads", action="store_true",
+                        help="identical fruit: do not draw mass, size, modulus, failure stress and susceptibility "
+                             "from the fruit's library spreads (by default a lot varies; giving an option fixes it)")
+
+
+def lot_distributions(args, fruit: str | None, given: list[str]):
+    """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
+    (the default fruit when None): the library spreads of the inputs not in ``given`` (issue 14 item 4),
+    none with ``--no-spreads``."""
+    from ..presets import lot_spreads
+
+    fruit = fruit or INPUTS["fruit"].default
+    if args.no_spreads:
+        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",)
+    spreads = lot_spreads(fruit, given)
+    return spreads.distributions, spreads.diameter_density, spreads.described
+
+
+def print_spreads(command: str, lines) -> None:
+    """The spreads a lot was drawn from, on stderr (the results stay on stdout)."""
+    print(f"{PROG} {command}: the lot varies as (give an option to fix it, --no-spreads for identical fruit):",
+          file=sys.stderr)
+    for line in lines:
+        print(f"  {line}", file=sys.stderr)

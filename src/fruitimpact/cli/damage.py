@@ -6,7 +6,8 @@ import math
 import sys
 
 from ..quantities import INPUTS, OUTPUTS
-from .common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
+from .common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
+                     dump_json, lot_distributions, print_spreads)
 
 #: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
 MAP_HEIGHTS = 30
@@ -202,13 +203,26 @@ def cmd_line(args) -> int:
             distributions.append((quantity.name, parse_distribution(spec, quantity.dimension, quantity.name)))
         except ValueError as exc:
             raise UsageError(f"argument {quantity.option}: {exc}") from None
-    source = runs.PopulationSource(tuple(distributions), (), rows, seed)
+    spreads, density, spread_lines = lot_distributions(args, constants.get("fruit"), [n for n, _ in distributions])
+    distributions += list(spreads)
+    source = runs.PopulationSource(tuple(distributions), (), rows, seed, density)
     members, _ = source.inputs(0, rows, None)
     members.pop("model", None)
-    report = _library_call(audit, points, members, rows, criterion, constants)
+    alternatives = () if args.alternatives.strip().lower() == "none" else \
+        tuple(a.strip() for a in args.alternatives.split(",") if a.strip())
+    from ..registries import SURFACE_CHOICES
+
+    unknown = [a for a in alternatives if a not in SURFACE_CHOICES or a in ("rigid", "fruit")]
+    if unknown:
+        raise UsageError(f"argument --alternatives: {unknown[0]!r} is not a library surface; give names from "
+                         f"fruitimpact surfaces (comma-separated) or none")
+    report = _library_call(audit, points, members, rows, criterion, constants, alternatives)
     _print_warnings("line", report["warnings"])
     report["seed"] = seed
     report["inputs"] = {name: dist.describe() for name, dist in distributions}
+    report["spreads"] = list(spread_lines)
+    if not args.json:
+        print_spreads("line", spread_lines)
     if args.plot:
         from ..plotting import save_figure
         from ..plotting.damage import line_figure
@@ -228,6 +242,11 @@ def cmd_line(args) -> int:
                   f"{point['cumulative_incidence'] * 100:>10.3g}%{point['cumulative_bruise_volume'] * 1e9:>10.4g}"
                   f"{point['mean_peak_force']:>11.4g}")
         print(f"most harmful transfer point: {report['worst_point']}")
+        for change in report["changes"][:5]:
+            print(f"  {change['to']} in place of {change['from']} at {change['point']}: line incidence "
+                  f"{change['incidence'] * 100:.3g} % (saves {change['incidence_saved'] * 100:.3g} points), mean "
+                  f"bruise volume {change['mean_bruise_volume'] * 1e9:.4g} mm³ (saves "
+                  f"{change['bruise_volume_saved'] * 1e9:.4g})")
         if args.plot:
             print(f"figure written to {args.plot}")
     return 0
@@ -305,6 +324,10 @@ def add_parsers(sub) -> None:
                                help=quantity.doc)
     group.add_argument("-n", "--rows", default="10000", metavar="N", help="fruit in the population (default 10000)")
     group.add_argument("--seed", default="0", metavar="S", help="random seed (default 0)")
+    add_spread_option(group)
+    ln.add_argument("--alternatives", default="foam-pad", metavar="SURFACES",
+                    help="library surfaces tried in place of each transfer point's, to say what each change would "
+                         "save (comma-separated; default foam-pad; none to skip)")
     ln.add_argument("--plot", metavar="FILE", help="incidence and bruise volume along the line (PNG/SVG/PDF)")
     ln.add_argument("--json", action="store_true", help="print one JSON object (SI)")
     ln.set_defaults(func=cmd_line)

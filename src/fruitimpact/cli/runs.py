@@ -14,7 +14,7 @@ import math
 import sys
 from pathlib import Path
 
-from .common import PROG, UsageError, _with_option, dump_json
+from .common import PROG, UsageError, _with_option, add_spread_option, dump_json, lot_distributions, print_spreads
 
 #: Inputs whose range depends on other inputs: not checked alone when constant.
 _DEPENDENT_INPUTS = ("alpha", "step")
@@ -311,6 +311,8 @@ def cmd_population(args) -> int:
             constants[dest] = dist.value
     _check_conflicts([d for d, _ in distributions])
     _check_constants(constants, text, [d for d, _ in distributions] + list(text))
+    spreads, density, spread_lines = lot_distributions(args, text.get("fruit"), [d for d, _ in distributions])
+    distributions += list(spreads)
     try:
         names = runs.characteristics_list(args.characteristics) if args.characteristics else runs.DEFAULT_SUMMARY
     except ValueError as exc:
@@ -328,7 +330,7 @@ def cmd_population(args) -> int:
     if not all(0 <= p <= 100 for p in percentiles):
         raise UsageError(f"argument --percentiles: each must be a number in [0, 100]; got {args.percentiles!r}")
     _check_figure("--hist", args.hist)
-    source = runs.PopulationSource(tuple(distributions), tuple(text.items()), rows, seed)
+    source = runs.PopulationSource(tuple(distributions), tuple(text.items()), rows, seed, density)
     plan = runs.Plan("population", source, _count("--chunk-size", args.chunk_size, 1, runs.MAX_CHUNK_ROWS),
                      write_rows=args.output is not None, stats=names, thresholds=tuple(thresholds),
                      sample_rows=_count("--sample-size", args.sample_size, 1, runs.MAX_SAMPLE_ROWS))
@@ -340,8 +342,10 @@ def cmd_population(args) -> int:
     if args.json:
         report = summary.to_dict()
         report["seed"], report["inputs"] = seed, {name: dist.describe() for name, dist in distributions}
+        report["spreads"] = list(spread_lines)
         print(dump_json(report))
     else:
+        print_spreads("population", spread_lines)
         print(_format_population(summary, names))
         for what, path in (("rows", summary.output), ("histograms", args.hist)):
             if path:
@@ -405,6 +409,7 @@ def add_parsers(sub) -> None:
     group.add_argument("-n", "--rows", default="10000", metavar="N",
                        help=f"members, 1 to {MAX_ROWS:,} (default 10000; 1e7 allowed)")
     group.add_argument("--seed", default="0", metavar="S", help="random seed, integer >= 0, exact (default 0)")
+    add_spread_option(group)
     stats = pop.add_argument_group("summary")
     stats.add_argument("--characteristics", metavar="LIST",
                        help="characteristics summarised and histogrammed, comma-separated (default: all twelve)")

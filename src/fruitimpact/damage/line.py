@@ -95,7 +95,12 @@ def read_line(path) -> list[TransferPoint]:
     return points
 
 
-def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str, constants: dict) -> dict:
+#: The surface tried in place of each transfer point's by default (``audit``'s ``alternatives``).
+DEFAULT_ALTERNATIVES = ("foam-pad",)
+
+
+def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str, constants: dict,
+          alternatives=DEFAULT_ALTERNATIVES) -> dict:
     """Pass ``rows`` fruit (``members``: input columns of the population) through ``points``.
 
     ``constants``: inputs shared by all (criterion inputs, model …).  Returns a dict with
@@ -104,7 +109,12 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``mean_max_pressure``, ``cumulative_incidence``, ``cumulative_bruise_volume``, ``invalid``,
     ``failed``), ``worst_point``, ``incidence`` (on the whole line), ``mean_bruise_volume``,
     ``criterion`` and ``warnings``.  A point's figures are over the fruit computed there; the
-    cumulated ones over the fruit computed at every point so far (a warning counts the others)."""
+    cumulated ones over the fruit computed at every point so far (a warning counts the others).
+
+    ``alternatives``: library surfaces tried in place of each point's own (not at fruit-on-fruit points):
+    ``changes`` lists, best first, each (point, surface) with the line's incidence and mean bruise volume
+    with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
+    difference)."""
     from ..batch import evaluation
     from ..constants import STANDARD_GRAVITY
     from ..validation import InputError
@@ -114,10 +124,15 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     valid_so_far = np.ones(rows, dtype=bool)  # fruit computed at every point so far: the cumulation's population
     report = []
     warnings = []
-    for point in points:
+    per_point = []  # (bruised, volume, ok) of each point, for the changes
+
+    def run(point, surface):
         table = {**members, **constants, "drop_height": np.full(rows, point.drop_height),
-                 "surface": "fruit" if point.fruit_on_fruit else point.surface, "criterion": criterion}
-        result = evaluation(table)
+                 "surface": surface, "criterion": criterion}
+        return evaluation(table)
+
+    for point in points:
+        result = run(point, "fruit" if point.fruit_on_fruit else point.surface)
         status = result.status
         ok = status == 0
         if not ok.any() and (status == 3).all():
@@ -125,6 +140,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
                              result.messages.argument(0))
         bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
         volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
+        per_point.append((bruised, volume, ok))
         bruised_any |= bruised
         volume_total += volume
         valid_so_far &= ok
@@ -149,9 +165,36 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         })
     worst = max(range(len(report)), key=lambda i: (report[i]["incidence"], report[i]["mean_bruise_volume"]))
     kept = max(int(valid_so_far.sum()), 1)
+    incidence = float(bruised_any[valid_so_far].sum() / kept)
+    mean_volume = float(volume_total[valid_so_far].sum() / kept)
+    changes = []
+    for k, point in enumerate(points):
+        for surface in alternatives:
+            if point.fruit_on_fruit or surface == point.surface:
+                continue
+            result = run(point, surface)
+            ok = (result.status == 0) & valid_so_far
+            if not ok.any():
+                continue
+            bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
+            volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
+            others_bruised = np.zeros(rows, dtype=bool)
+            others_volume = np.zeros(rows)
+            for j, (b, v, _) in enumerate(per_point):
+                if j != k:
+                    others_bruised |= b
+                    others_volume += v
+            changed = float((others_bruised | bruised)[ok].mean())
+            changed_volume = float((others_volume + volume)[ok].mean())
+            base = float(bruised_any[ok].mean())
+            base_volume = float(volume_total[ok].mean())
+            changes.append({"point": point.name, "from": point.surface, "to": surface, "incidence": changed,
+                            "incidence_saved": base - changed, "mean_bruise_volume": changed_volume,
+                            "bruise_volume_saved": base_volume - changed_volume, "fruit": int(ok.sum())})
+    changes.sort(key=lambda c: (-c["incidence_saved"], -c["bruise_volume_saved"]))
     return {"criterion": criterion, "fruit": rows, "fruit_computed": int(valid_so_far.sum()), "points": report,
-            "worst_point": report[worst]["name"], "incidence": float(bruised_any[valid_so_far].sum() / kept),
-            "mean_bruise_volume": float(volume_total[valid_so_far].sum() / kept), "warnings": warnings}
+            "worst_point": report[worst]["name"], "incidence": incidence, "mean_bruise_volume": mean_volume,
+            "changes": changes, "warnings": warnings}
 
 
-__all__ = ["LINE_COLUMNS", "MAX_POINTS", "TransferPoint", "audit", "read_line"]
+__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "MAX_POINTS", "TransferPoint", "audit", "read_line"]

@@ -398,10 +398,16 @@ class PopulationSource:
     text: tuple  # of (name, value)
     rows: int
     seed: int
+    #: Density [kg/m³] from which each member's diameter follows its drawn mass, d = (6 m / (π ρ))^(1/3)
+    #: (a lot drawn from a fruit's spreads: a heavier fruit is a bigger one); None: no such column.
+    diameter_density: float | None = None
 
     def identity(self) -> dict:
-        return {"population": {name: dist.identity() for name, dist in self.distributions},
-                "text": dict(self.text), "rows": self.rows, "seed": self.seed, "block": BLOCK_ROWS}
+        identity = {"population": {name: dist.identity() for name, dist in self.distributions},
+                    "text": dict(self.text), "rows": self.rows, "seed": self.seed, "block": BLOCK_ROWS}
+        if self.diameter_density is not None:
+            identity["diameter_density"] = self.diameter_density
+        return identity
 
     def payloads(self, chunk_rows: int):
         for index in range(-(-self.rows // chunk_rows)):
@@ -428,6 +434,8 @@ class PopulationSource:
                 columns[name] = np.full(stop - start, dist.value)
             else:
                 columns[name] = self._stream(start, stop, stream_number(name), dist.draw)
+        if self.diameter_density is not None:
+            columns["diameter"] = np.cbrt(6.0 * columns["mass"] / (np.pi * self.diameter_density))
         for name, value in self.text:
             columns[name] = Labels.constant(value, stop - start)
         # with every input at its default there would be no column to carry the row count
