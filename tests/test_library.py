@@ -211,7 +211,8 @@ def test_registries_are_read_only_and_records_frozen():
 
 FRUIT_REQUIRED = {"mass", "diameter", "modulus", "poisson"}
 FRUIT_OPTIONAL = {"failure_stress", "bruise_susceptibility", "bruise_threshold_energy", "restitution"}
-SURFACE_KEYS = {"surface_modulus", "surface_poisson", "surface_radius", "surface_thickness", "surface_model"}
+SURFACE_KEYS = {"surface_modulus", "surface_poisson", "surface_radius", "surface_thickness", "surface_crush_stress",
+                "surface_model"}
 
 
 def test_fruit_inputs_keys():
@@ -246,11 +247,11 @@ def test_fruit_surface_is_an_identical_fruit():
     assert partner.modulus is partner.poisson is partner.thickness is partner.radius is None
     assert all(surface(name).partner is None for name in CONTRACT_SURFACES if name != "fruit")
     assert partner.inputs() == {"surface_modulus": None, "surface_poisson": None, "surface_radius": None,
-                                "surface_thickness": None, "surface_model": "fruit"}
+                                "surface_thickness": None, "surface_crush_stress": None, "surface_model": "fruit"}
     apple = fruit("apple")
     assert partner.inputs(apple) == {"surface_modulus": apple.modulus.value, "surface_poisson": apple.poisson.value,
                                      "surface_radius": apple.diameter.value / 2, "surface_thickness": math.inf,
-                                     "surface_model": "fruit"}
+                                     "surface_crush_stress": None, "surface_model": "fruit"}
 
 
 # --------------------------------------------------------------------------- hard surfaces are rigid

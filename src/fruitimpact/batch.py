@@ -19,6 +19,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 
 from . import contact
@@ -32,7 +34,8 @@ from .models import DAMPING_LAWS
 from .registries import REGISTRIES
 from . import presets
 from .damage.assess import CRITERION_NAMES, bruise_columns
-from .engine.plastic import PLASTIC_COLUMNS, plastic_characteristics, winkler_stiffness, yield_pressure_of_force
+from .engine.plastic import (PLASTIC_COLUMNS, crushing_characteristics, plastic_characteristics, winkler_stiffness,
+                             yield_pressure_of_force)
 from .quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
                          NUMERIC_INPUTS, PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
 from .solvers import SOLVERS, max_rk4_step, power_law_closed_forms
@@ -219,6 +222,13 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
         else np.full(rows, np.inf)
     plastic = np.isfinite(yield_pressure) | layer
     _check_damage_inputs(inputs, resolved, layer, used, thickness, messages, warnings)
+    # a board that crushes (issue 14 item 3): its flutes collapse where the pressure under the fruit, k δ_L at
+    # the centre of the Winkler layer, reaches the flat-crush strength σ_c; the crushed board carries no more
+    # and the fruit meets the floor, so the layer bottoms out at δ_L = σ_c/k (k = K_L/(π R)) instead of at h
+    crush = used["surface_crush_stress"]
+    crushing = layer & np.isfinite(crush) if any_layer else np.zeros(rows, dtype=bool)
+    bottoming = np.where(crushing, np.minimum(thickness, crush * math.pi * radius / layer_stiffness), thickness) \
+        if crushing.any() else thickness
 
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
@@ -334,10 +344,13 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             group = np.empty((idx.size, N_CHARACTERISTICS))
             if plastic_block is None:
                 plastic_block = np.full((rows, len(PLASTIC_COLUMNS)), np.nan)
-            group[group_plastic], plastic_block[plastic_rows] = plastic_characteristics(
+            engine = crushing_characteristics if crushing[plastic_rows].all() else plastic_characteristics
+            if crushing[plastic_rows].any() and not crushing[plastic_rows].all():
+                engine = _mixed_crushing(crushing[plastic_rows])
+            group[group_plastic], plastic_block[plastic_rows] = engine(
                 mass[plastic_rows], velocity[plastic_rows], stiffness[plastic_rows], radius[plastic_rows],
                 contact_modulus[plastic_rows], yield_pressure[plastic_rows], layer_stiffness[plastic_rows],
-                thickness[plastic_rows], factor[plastic_rows])
+                bottoming[plastic_rows], factor[plastic_rows])
             if elastic_rows.size:
                 group[~group_plastic] = solver.batch(law, law_stiffness[elastic_rows], factor[elastic_rows],
                                                      mass[elastic_rows], velocity[elastic_rows],
@@ -368,7 +381,8 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                    f"place of the fruit is more than 4 % off; treat the figures as an estimate")
 
     done = status != INVALID
-    _range_warnings(warnings, out, plastic_block, layer, thickness, used["surface_thickness"], radius, done, detail)
+    _range_warnings(warnings, out, plastic_block, layer, thickness, used["surface_thickness"], radius, done, detail,
+                    crushing)
     # failed rows carry no damage figures (their characteristics are not an impact)
     damage = _damage_columns(out, plastic_block, done & (status != FAILED), mass, velocity, used, inputs,
                              fruit_modulus, pair_modulus, layer, resolved)
@@ -455,7 +469,7 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
 
 
 def _range_warnings(warnings: WarningBook, out, plastic_block, layer, thickness, given_thickness, radius, done,
-                    detail: bool) -> None:
+                    detail: bool, crushing) -> None:
     """Warnings where a surface model is used outside its range."""
     if out is None:
         return
@@ -469,9 +483,14 @@ def _range_warnings(warnings: WarningBook, out, plastic_block, layer, thickness,
                                 f"estimate")
         if plastic_block is not None:
             bottomed = done & layer & (plastic_block[:, PLASTIC_COLUMNS.index("bottomed_out")] == 1.0)
-            if bottomed.any():
-                warnings.add(bottomed, "the pad bottoms out: its deflection reaches its thickness, and the force "
-                                       "beyond that is carried by the substrate as if rigid")
+            crushed = bottomed & crushing
+            if crushed.any():
+                warnings.add(crushed, "the board crushes: the pressure under the fruit reaches its flat-crush "
+                                      "strength, the flutes collapse and the force beyond is carried by the floor "
+                                      "as if rigid")
+            if (bottomed & ~crushing).any():
+                warnings.add(bottomed & ~crushing, "the pad bottoms out: its deflection reaches its thickness, and "
+                                                   "the force beyond that is carried by the substrate as if rigid")
     half_space_layer = done & ~layer & np.isfinite(given_thickness) & (a > given_thickness)
     if half_space_layer.any():
         warnings.add(half_space_layer, "the contact radius exceeds the surface thickness: Hertz's half-space does not "
@@ -521,6 +540,17 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
                                   susceptibility=used["bruise_susceptibility"],
                                   contact_radius=out[:, CONTACT_RADIUS], valid=done))
     return {name: columns[name] for name in (*DAMAGE_NAMES, "bruise_energy")}
+
+
+def _mixed_crushing(crushing: np.ndarray):
+    """The plastic engine for a group of rows of which only ``crushing`` ones are on a board that crushes."""
+    def engine(*columns):
+        out = np.empty((crushing.size, N_CHARACTERISTICS))
+        extra = np.empty((crushing.size, len(PLASTIC_COLUMNS)))
+        for mask, run in ((crushing, crushing_characteristics), (~crushing, plastic_characteristics)):
+            out[mask], extra[mask] = run(*(np.asarray(c)[mask] for c in columns))
+        return out, extra
+    return engine
 
 
 def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):

@@ -98,12 +98,16 @@ class Surface:
     thickness : float
         Thickness h [m] of a cushion on a rigid substrate (``inf``: a half-space); with
         ``surface_model="layer"`` the elastic-foundation model of ``engine.plastic``.
+    crush_stress : float
+        Flat-crush strength σ_c [Pa] of a layer that crushes (corrugated board; ``inf``: it does not),
+        ``engine.plastic.crushing_characteristics``.
     """
 
     modulus: float = INPUTS["surface_modulus"].default
     poisson: float = INPUTS["surface_poisson"].default
     radius: float = INPUTS["surface_radius"].default
     thickness: float = INPUTS["surface_thickness"].default
+    crush_stress: float = INPUTS["surface_crush_stress"].default
 
     def __post_init__(self):
         for item in fields(self):
@@ -441,7 +445,7 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
     fruit_used = Fruit._checked(**{name: float(columns[name]) for name in ("mass", "diameter", "modulus", "poisson")},
                                 stiffness=row["stiffness"][0] if "stiffness" in row else None)
     surface_used = Surface._checked(**{name: float(columns["surface_" + name])
-                                       for name in ("modulus", "poisson", "radius", "thickness")})
+                                       for name in ("modulus", "poisson", "radius", "thickness", "crush_stress")})
     given = {name: (row[name][0] if name in row else None) for name in ("restitution", "alpha", "damping")}
     target = float(columns["target_restitution"])
     inputs_used = ImpactInputs(fruit=fruit_used, surface=surface_used, velocity=float(columns["velocity"]),

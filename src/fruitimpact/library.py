@@ -44,7 +44,9 @@ FRUIT_UNITS = {
     "restitution": "", "alpha": "s/m", "bruise_susceptibility": "m^3/J", "bruise_threshold_energy": "J",
 }
 #: The numeric fields of a surface and their SI units.
-SURFACE_UNITS = {"modulus": "Pa", "poisson": "", "thickness": "m", "radius": "m"}
+SURFACE_UNITS = {"modulus": "Pa", "poisson": "", "thickness": "m", "radius": "m", "crush_stress": "Pa"}
+#: Surface values that only some surfaces have (the others leave them empty).
+_SURFACE_OPTIONAL = ("crush_stress",)
 #: Contact models of a surface: Hertz half-space through E* and R; elastic-foundation (Winkler) layer of
 #: thickness h on a rigid substrate; an identical free fruit.
 SURFACE_MODELS = ("half-space", "layer", "fruit")
@@ -191,6 +193,9 @@ class Surface:
         Radius of curvature R₂ [m]; ``inf`` is flat; ``None`` for ``fruit`` (the fruit's d/2).
     partner : str or None
         ``"fruit"`` for the identical free fruit, else ``None``.
+    crush_stress : Value or None
+        Flat-crush strength σ_c [Pa] of a layer that collapses (corrugated board): the layer bottoms out where
+        the pressure under the fruit reaches it; ``None``: the layer does not crush.
     """
 
     name: str
@@ -202,6 +207,7 @@ class Surface:
     thickness: Value | None
     radius: Value | None
     partner: str | None
+    crush_stress: Value | None = None
 
     def values(self) -> dict[str, Value]:
         """The known numeric properties, by field name."""
@@ -223,8 +229,9 @@ class Surface:
         else:
             modulus, poisson = fruit.modulus.value, fruit.poisson.value
             radius, thickness = fruit.diameter.value / 2.0, math.inf
+        crush = self.crush_stress.value if self.crush_stress is not None else None
         return {"surface_modulus": modulus, "surface_poisson": poisson, "surface_radius": radius,
-                "surface_thickness": thickness, "surface_model": self.model}
+                "surface_thickness": thickness, "surface_crush_stress": crush, "surface_model": self.model}
 
 
 # ----------------------------------------------------------------------------------------------- loading
@@ -329,13 +336,15 @@ def surfaces() -> Mapping[str, Surface]:
         if model not in SURFACE_MODELS:
             raise LibraryError(f"{where}: model must be one of {', '.join(SURFACE_MODELS)}; got {model!r}")
         given = [field for field, value in values.items() if value is not None]
+        if values["crush_stress"] is not None and model != "layer":
+            raise LibraryError(f"{where}: only a layer can crush (crush_stress)")
         if model == "fruit":
             if partner != "fruit" or given:
                 raise LibraryError(f"{where}: a fruit surface has partner 'fruit' and no numbers")
         else:
             if partner is not None:
                 raise LibraryError(f"{where}: only a fruit surface has a partner")
-            absent = [field for field, value in values.items() if value is None]
+            absent = [field for field, value in values.items() if value is None and field not in _SURFACE_OPTIONAL]
             if absent:
                 raise LibraryError(f"{where}: {', '.join(absent)} must be given")
             thickness = values["thickness"]

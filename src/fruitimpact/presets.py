@@ -146,7 +146,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
                 defaults.put(key, where, used(source)[where], single)
             defaults.put("surface_radius", where, used("diameter")[where] / 2.0, single)
             continue
-        for key in ("surface_modulus", "surface_poisson", "surface_radius", "surface_thickness"):
+        for key in ("surface_modulus", "surface_poisson", "surface_radius", "surface_thickness", "surface_crush_stress"):
             if preset[key] is not None:
                 defaults.put(key, where, preset[key], single)
         if preset["surface_model"] == "layer":

@@ -181,6 +181,10 @@ INPUTS: dict[str, Quantity] = _table(
     Quantity("surface_thickness", "h", "surface thickness h", "length", "mm", 1e3,
              "thickness of a cushion, pad or belt cover on a rigid substrate (default inf: a half-space)",
              POSITIVE_OR_INFINITE, None, math.inf, "--surface-thickness"),
+    Quantity("surface_crush_stress", "σ_c", "surface crush stress σ_c", "modulus", "kPa", 1e-3,
+             "flat-crush strength of a cushion layer (corrugated board: its flutes collapse when the pressure under "
+             "the fruit reaches it, and the fruit meets the floor; default: the --surface's, else none)",
+             POSITIVE_OR_INFINITE, None, math.inf, "--surface-crush-stress"),
     Quantity("partner_mass", "m_2", "partner mass m_2", "mass", "g", 1e3,
              "mass of a free partner (another fruit): the reduced mass m m_2/(m + m_2) moves; --velocity is then "
              "the approach speed (default inf: a fixed surface)",

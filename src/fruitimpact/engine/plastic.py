@@ -58,7 +58,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .codes import N_CHARACTERISTICS
+from .codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
 from .powerlaw import r_func
 from .quadrature import gauss_jacobi
 
@@ -634,5 +634,45 @@ def plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, 
     return out, extra
 
 
-__all__ = ["N_PLASTIC", "PLASTIC_COLUMNS", "plastic_characteristics", "plastic_curves", "winkler_stiffness", "yield_force",
-           "yield_pressure_of_force"]
+def crushing_characteristics(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness,
+                             crush_depth, damping_factor) -> tuple[np.ndarray, np.ndarray]:
+    """Impacts on a board that crushes (corrugated cardboard, issue 14 item 3), one row per impact.
+
+    The board is the Winkler layer of ``plastic_characteristics`` up to its crush depth δ_c [m] (where the
+    centre pressure k δ_L reaches its flat-crush strength σ_c: δ_c = σ_c/k).  An impact that does not reach
+    the crush force F_c = K_L δ_c² is that layer impact.  One that does crushes the flutes: the board has then
+    taken W_c = K_L δ_c³/3 [J] (the work of F = K_L δ_L² up to δ_c, lost in the crushed board) and the fruit
+    meets the floor, as on a rigid half-space, at the speed left, V' = √(V² − 2 W_c/m).  Reported for those
+    rows: the rigid impact at V' (forces, pressure, times, deflections of the fruit), the exit speed e' V', the
+    restitution e' V'/V, the absorbed energy ½ m (V² − (e' V')²) and the fruit's share of it (the board's W_c
+    is not the fruit's); ``bottomed_out`` is 1.  Arguments as for ``plastic_characteristics``."""
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
+                                   (mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
+                                    layer_stiffness, crush_depth, damping_factor)))
+    m, v, k, r, e_star, p_y, k_l, depth, c = (np.ascontiguousarray(a.ravel()) for a in arrays)
+    out, extra = plastic_characteristics(m, v, k, r, e_star, p_y, k_l, depth, c)
+    bottom = extra[:, PLASTIC_COLUMNS.index("bottomed_out")] == 1.0
+    crush_work = k_l * depth ** 3 / 3.0
+    left = v ** 2 - 2.0 * crush_work / m
+    crushed = np.flatnonzero(bottom & (left > 0.0))
+    if crushed.size:
+        v_left = np.sqrt(left[crushed])
+        rigid, rigid_extra = plastic_characteristics(m[crushed], v_left, k[crushed], r[crushed], e_star[crushed],
+                                                     p_y[crushed], math.inf, math.inf, c[crushed])
+        exit_speed = rigid[:, EXIT_VELOCITY]
+        total = 0.5 * m[crushed] * (v[crushed] ** 2 - exit_speed ** 2)
+        fruit = 0.5 * m[crushed] * (v_left ** 2 - exit_speed ** 2)
+        rigid[:, RESTITUTION] = exit_speed / v[crushed]
+        rigid[:, ABSORBED_ENERGY] = total
+        rigid_extra[:, PLASTIC_COLUMNS.index("bottomed_out")] = 1.0
+        rigid_extra[:, PLASTIC_COLUMNS.index("fruit_work_share")] = fruit / total
+        rigid_extra[:, PLASTIC_COLUMNS.index("yield_velocity")] = np.where(
+            np.isfinite(rigid_extra[:, 0]), np.sqrt(rigid_extra[:, 0] ** 2 + 2.0 * crush_work[crushed] / m[crushed]),
+            np.inf)  # the drop speed at which the fruit would yield, the board's share added back
+        out[crushed] = rigid
+        extra[crushed] = rigid_extra
+    return out, extra
+
+
+__all__ = ["N_PLASTIC", "PLASTIC_COLUMNS", "crushing_characteristics", "plastic_characteristics", "plastic_curves",
+           "winkler_stiffness", "yield_force", "yield_pressure_of_force"]
