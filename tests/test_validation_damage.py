@@ -106,12 +106,12 @@ def test_slupska_foam_protects_up_to_50_mm_only():
     assert 0.050 < _onset("apple", "foam-pad")["safe_height"] <= 0.150
 
 
-@pytest.mark.xfail(strict=True, reason="cardboard is a linear Winkler layer that never crushes: shear onset "
-                   "941 mm, no bruise at 150 mm, where Słupska's apples bruised as on wood (issue 14 item 3)")
 def test_slupska_cardboard_bruises_like_wood_at_the_highest_drops():
     """Słupska et al. 2022: "as the drop height increased, the cardboard degraded and the apple bruising level
     reached the results as for wood and concrete". Tolerance: the weakest reading of that sentence, that the
-    apple bruises on cardboard by the highest drop tested, 150 mm (onset at or below 150 mm)."""
+    apple bruises on cardboard by the highest drop tested, 150 mm (onset at or below 150 mm). Passes since the
+    board crushes at its flat-crush stress (issue 14 item 3; before, a never-crushing layer gave 941 mm); that
+    stress is unsourced in the library, so this holds the structure, not the board's values."""
     assert _onset("apple", "cardboard")["safe_height"] <= 0.150
 
 
