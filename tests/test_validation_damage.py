@@ -129,8 +129,6 @@ def test_mencarelli_kiwifruit_is_damaged_by_30_cm_onto_steel():
 # --- potato: Stropek & Gołacki 2022, "Studies concerning the response of potatoes to impact", Int. Agrophys.
 # 36(2):115-122: 'Ramos' tubers of 160-190 g on an impact plate.
 
-@pytest.mark.xfail(strict=True, reason="the potato entry has no restitution: the default 0.577 (the founding "
-                   "paper's Jonathan apple) is used, above Stropek's 0.44-0.49")
 def test_stropek_potato_restitution():
     """Stropek & Gołacki 2022: "The restitution coefficient changed to an insignificant extent which amounted to
     0.44-0.49 in the tested range of the impact velocity" (bruise onset at 1 m/s, tested up to 1.75 m/s).

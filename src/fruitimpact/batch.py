@@ -210,6 +210,12 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     damped_given = given["alpha"] | given["damping"]
     target = np.where(given["restitution"], values["restitution"],
                       np.where(damped_given, np.nan, resolved.restitution))
+    defaulted = resolved.missing["restitution"] & ~given["restitution"] & ~damped_given
+    for fruit in sorted(set(resolved.fruit_of[defaulted])) if defaulted.any() else ():
+        warnings.add(defaulted & (resolved.fruit_of == fruit),
+                     f"restitution is not in the {fruit} entry of the fruit library: the default "
+                     f"{GROUP_DEFAULTS['restitution']:g} (the founding paper's Jonathan apple at 1 m/s) is used; give "
+                     f"--restitution")
     used["velocity"], used["stiffness"] = velocity, stiffness
     # a free partner (another fruit): the reduced mass moves at the approach speed
     mass = presets.effective_mass(used["mass"], used["partner_mass"])

@@ -38,8 +38,8 @@ class Resolved:
     array of one value per row; only the inputs that presets or damage defaults touch), the
     surface model code per row, the default target restitution (float or per row), the rows
     whose ``bruise_energy`` comes from nobody (neither given nor in the fruit's library entry), and
-    ``missing``: for each damage input of ``DAMAGE_DEFAULTS``, the rows whose ``--fruit`` entry has no value
-    for it (NaN there unless the user gives one), with ``fruit_of`` the fruit name of each row ("" without);
+    ``missing``: for each damage input of ``DAMAGE_DEFAULTS`` and for ``restitution``, the rows whose ``--fruit``
+    entry has no value for it (NaN there unless the user gives one; the restitution: the default target), with ``fruit_of`` the fruit name of each row ("" without);
     ``impact_basis``: for ``bruise_susceptibility`` and ``bruise_energy``, the rows whose value is on the
     impact-energy basis (the user's ``bruise_basis`` for a value given, the library's for the fruit's own;
     else absorbed)."""
@@ -85,7 +85,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     for name, value in DAMAGE_DEFAULTS.items():
         defaults[name] = value
     no_threshold = np.ones(rows, dtype=bool)
-    missing = {name: np.zeros(rows, dtype=bool) for name in DAMAGE_DEFAULTS}
+    missing = {name: np.zeros(rows, dtype=bool) for name in (*DAMAGE_DEFAULTS, "restitution")}
     impact_basis = {name: np.zeros(rows, dtype=bool) for name in ("bruise_susceptibility", "bruise_energy")}
     fruit_of = np.full(rows, "", dtype=object)
     restitution = default_restitution
@@ -98,6 +98,8 @@ def resolve(inputs, default_restitution: float) -> Resolved:
         where = slice(None) if single else fruit_labels.codes == code
         fruit_of[where] = name
         entry = fruits[name].inputs()
+        if entry.get("restitution") is None:
+            missing["restitution"][where] = True
         for key in DAMAGE_DEFAULTS:
             if key != "bruise_energy" and entry.get(_LIBRARY_KEYS.get(key, key)) is None:
                 defaults.put(key, where, math.nan, single)

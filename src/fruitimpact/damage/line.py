@@ -139,7 +139,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             raise InputError(f"transfer point {point.name!r}: {result.messages.text(0)}",
                              result.messages.argument(0))
         bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
-        volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
+        # a bruised fruit without a volume (no bruise susceptibility) leaves the mean volume unknown, never 0
+        volume = np.where(bruised, result.columns["bruise_volume"], 0.0)
         per_point.append((bruised, volume, ok))
         bruised_any |= bruised
         volume_total += volume
@@ -177,7 +178,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             if not ok.any():
                 continue
             bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
-            volume = np.where(ok, np.nan_to_num(result.columns["bruise_volume"]), 0.0)
+            volume = np.where(bruised, result.columns["bruise_volume"], 0.0)
             others_bruised = np.zeros(rows, dtype=bool)
             others_volume = np.zeros(rows)
             for j, (b, v, _) in enumerate(per_point):
