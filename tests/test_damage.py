@@ -499,3 +499,71 @@ def test_cardboard_protects_only_below_its_crush():
     low = batch.evaluate({"fruit": ["apple"] * 2, "surface": ["steel", "cardboard"], "drop_height": [0.0005] * 2})
     assert low.loc[1, "peak_force"] < 0.9 * low.loc[0, "peak_force"]
     assert "the board crushes" not in low.loc[1, "warnings"]
+
+
+# ------------------------------------------------------- defects found by the review of issue 14 (helper attack)
+@pytest.mark.parametrize("argv, option", [
+    (("population", "-n", "50", "--fruit", "pear", "--drop-height", "4cm", "--criterion", "shear"), "--failure-stress"),
+    (("sweep", "--fruit", "pear", "--criterion", "shear", "--velocity", "0.5:1:3", "-o", "sw.csv"), "--failure-stress"),
+    (("line", "examples/line.csv", "--fruit", "banana", "--criterion", "shear", "-n", "10"), "--fruit"),
+    (("line", "examples/line.csv", "--fruit", "apple", "--criterion", "shear", "-n", "10", "--alternatives", ""),
+     "--alternatives"),
+    (("line", "examples/line.csv", "--fruit", "apple", "--criterion", "shear", "-n", "10", "--alternatives", "rigid"),
+     "--alternatives"),
+    (("simulate", "--fruit", "apple", "--surface", "steel", "--surface-crush-stress", "150kPa"),
+     "--surface-crush-stress"),
+    (("drop", "--drop-height", "30cm", "--alpha", "0.3", "--bounces", "constant"), "--bounces"),
+])
+def test_issue14_options_refuse_what_they_cannot_do(cli, argv, option, monkeypatch):
+    import pathlib
+
+    monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])
+    assert option in cli.error(*argv)
+
+
+def test_a_lot_without_a_criterion_draws_no_bruise_inputs(cli):
+    """Before the review: the spreads drew failure stress and susceptibility without a criterion and every
+    member was refused ("a bruise input: give --criterion"), exit 0."""
+    report = cli.json("population", "--fruit", "apple", "-n", "100", "--drop-height", "4cm",
+                      "--characteristics", "peak_force")
+    assert report["ok"] == 100 and "failure_stress" not in report["inputs"]
+
+
+def test_the_lot_median_is_the_library_value():
+    """The spreads are split normals with their median at the library value (the library ranges are
+    asymmetric about it: a symmetric normal truncated to the range moved the apple's median modulus 23 % up)."""
+    from fruitimpact.presets import lot_spreads
+
+    for fruit in ("apple", "peach", "potato"):
+        for name, dist in lot_spreads(fruit, []).distributions:
+            draws = dist.draw(np.random.default_rng(2), 100_000)
+            value = getattr(__import__("fruitimpact.library", fromlist=["fruits"]).fruits()[fruit], name)
+            # the median of 1e5 draws is within ~0.4 % of the sd of the true median; 2 % of the range is ample
+            assert abs(np.median(draws) - value.value) < 0.02 * (value.high - value.low), (fruit, name)
+            assert draws.min() >= value.low and draws.max() <= value.high
+
+
+def test_kelvin_voigt_answers_the_energy_criterion():
+    """No Hertz pressure, but the energy criterion needs none (before: NaN bruised, status ok)."""
+    frame = batch.evaluate({"fruit": ["apple"], "model": ["kelvin-voigt"], "criterion": ["energy"],
+                            "drop_height": [0.3]})
+    assert frame.loc[0, "status"] == "ok" and frame.loc[0, "bruised"] == 1.0
+    assert frame.loc[0, "bruise_volume"] > 0
+
+
+def test_a_board_that_bottoms_before_its_crush_stress_is_the_plain_layer():
+    """A crush depth σ_c/k beyond the thickness: the board bottoms out first and never crushes (before: the
+    crush model ran anyway, with another peak force and a wrong warning)."""
+    common = {"fruit": ["apple"], "surface": ["cardboard"], "surface_thickness": [0.0015], "drop_height": [1.0]}
+    plain = batch.evaluate({**common, "surface_crush_stress": [math.inf]})
+    never = batch.evaluate({**common, "surface_crush_stress": [1e12]})
+    assert never.loc[0, "peak_force"] == plain.loc[0, "peak_force"]
+    assert "the board crushes" not in never.loc[0, "warnings"]
+
+
+def test_an_estimated_onset_energy_is_said():
+    """W_th = W_f (σ/q)^5 is exact only for elastic contact at a fixed e: plastic rows warn."""
+    frame = batch.evaluate({"fruit": ["apple"] * 2, "criterion": ["shear"] * 2, "drop_height": [0.3] * 2,
+                            "yield_pressure": [math.inf, 3.2e5]})
+    assert "Hertz-scaling estimate" not in frame.loc[0, "warnings"]
+    assert "Hertz-scaling estimate" in frame.loc[1, "warnings"]

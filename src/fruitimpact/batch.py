@@ -232,8 +232,9 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     # the centre of the Winkler layer, reaches the flat-crush strength σ_c; the crushed board carries no more
     # and the fruit meets the floor, so the layer bottoms out at δ_L = σ_c/k (k = K_L/(π R)) instead of at h
     crush = used["surface_crush_stress"]
-    crushing = layer & np.isfinite(crush) if any_layer else np.zeros(rows, dtype=bool)
-    bottoming = np.where(crushing, np.minimum(thickness, crush * math.pi * radius / layer_stiffness), thickness) \
+    crushing = layer & np.isfinite(crush) & (crush * math.pi * radius / layer_stiffness < thickness) \
+        if any_layer else np.zeros(rows, dtype=bool)
+    bottoming = np.where(crushing, crush * math.pi * radius / layer_stiffness, thickness) \
         if crushing.any() else thickness
 
     law_stiffness = np.full(rows, np.nan)
@@ -392,6 +393,15 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     # failed rows carry no damage figures (their characteristics are not an impact)
     damage = _damage_columns(out, plastic_block, done & (status != FAILED), mass, velocity, used, inputs,
                              fruit_modulus, pair_modulus, layer, resolved)
+    # the onset energy of a stress criterion, W_f (threshold/quantity)^5, is exact only for elastic contact on a
+    # half-space at a fixed restitution (damage.assess); say where a volume rests on it otherwise
+    estimated = (damage["bruised"] == 1.0) & (plastic | layer | damped_given) & np.isin(
+        inputs.text["criterion"].codes, [k for k, label in enumerate(inputs.text["criterion"].labels)
+                                         if label in ("pressure", "shear")])
+    warnings.add(estimated, "bruise volume: the onset energy it counts from is the Hertz-scaling estimate "
+                            "W_f (threshold/stress)^5, exact only for elastic contact on a half-space at a fixed "
+                            "restitution (not with plastic contact, a cushion, or damping given by alpha or "
+                            "damping): the volume may be off by tens of %; safe-height finds the exact onset")
     columns = {name: used[name] for name in NUMERIC_INPUTS if name in INPUT_OUTPUTS}
     columns["yield_pressure"] = yield_pressure
     columns["bruise_energy"] = damage.pop("bruise_energy")
@@ -438,6 +448,11 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
         rigid = layer & ~np.isfinite(used["surface_modulus"])
         messages.set(rigid & ~messages.flagged, "surface_modulus must be finite for a layer surface",
                      "surface_modulus")
+    if given["surface_crush_stress"].any():
+        messages.set(given["surface_crush_stress"] & ~layer & ~messages.flagged,
+                     "surface_crush_stress is the flat-crush strength of a cushion layer: give it with a layer "
+                     "surface (--surface cardboard, or --surface-model layer --surface-thickness H)",
+                     "surface_crush_stress")
     criteria = inputs.text["criterion"]
     for code, name in enumerate(criteria.labels):
         where = criteria.codes == code

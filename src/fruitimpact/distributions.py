@@ -165,6 +165,53 @@ class TruncNormal:
 
 
 @dataclass(frozen=True)
+class SplitNormal:
+    """Two half-normals joined at the ``median`` [SI]: below it |N(0, ``sd_low``)| is subtracted, above it
+    |N(0, ``sd_high``)| added, each side with probability ½ and truncated to [``lo``, ``hi``] (by redrawing that
+    side), so the median is exactly ``median`` however asymmetric the range.  A library value with its range
+    [low, high] read as a ±2 sd band on each side: ``sd_low = (median − lo)/2``, ``sd_high = (hi − median)/2``."""
+
+    median: float
+    sd_low: float
+    sd_high: float
+    lo: float
+    hi: float
+    signature = "splitnormal(median, sd_low, sd_high, lo, hi)"
+
+    def __post_init__(self):
+        values = (self.median, self.sd_low, self.sd_high, self.lo, self.hi)
+        if not all(math.isfinite(v) for v in values) or not self.lo <= self.median <= self.hi \
+                or self.sd_low < 0 or self.sd_high < 0 or not self.lo < self.hi:
+            raise ValueError("splitnormal(median, sd_low, sd_high, lo, hi) needs finite values, sd >= 0 and "
+                             "lo <= median <= hi, lo < hi")
+
+    def _side(self, rng, size: int, sd: float, limit: float) -> np.ndarray:
+        if sd == 0.0 or size == 0:
+            return np.zeros(size)
+        out = np.abs(rng.normal(0.0, sd, size))
+        bad = np.flatnonzero(out > limit)
+        while bad.size:
+            out[bad] = np.abs(rng.normal(0.0, sd, bad.size))
+            bad = bad[out[bad] > limit]
+        return out
+
+    def draw(self, rng, size: int) -> np.ndarray:
+        upper = rng.random(size) < 0.5
+        out = np.full(size, self.median)
+        n_up = int(upper.sum())
+        out[upper] += self._side(rng, n_up, self.sd_high, self.hi - self.median)
+        out[~upper] -= self._side(rng, size - n_up, self.sd_low, self.median - self.lo)
+        return out
+
+    def identity(self) -> dict:
+        return {"splitnormal": [self.median, self.sd_low, self.sd_high, self.lo, self.hi]}
+
+    def describe(self) -> str:
+        return (f"splitnormal(median={self.median:.6g}, sd below={self.sd_low:.6g}, sd above={self.sd_high:.6g}, "
+                f"in [{self.lo:.6g}, {self.hi:.6g}])")
+
+
+@dataclass(frozen=True)
 class Sample:
     """Bootstrap: members drawn with replacement from measured ``values`` [SI]."""
 
@@ -247,5 +294,5 @@ def parse_distribution(text: str, dimension: str, name: str | None = None):
     return cls(*values)
 
 
-__all__ = ["Constant", "Normal", "LogNormal", "Uniform", "TruncNormal", "Sample", "DISTRIBUTIONS",
+__all__ = ["Constant", "Normal", "LogNormal", "Uniform", "TruncNormal", "SplitNormal", "Sample", "DISTRIBUTIONS",
            "TRUNCNORMAL_MIN_MASS", "parse_distribution"]

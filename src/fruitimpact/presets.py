@@ -163,14 +163,16 @@ def resolve(inputs, default_restitution: float) -> Resolved:
 #: The properties a lot draws from its fruit's library spreads (issue 14 item 4), in this order; the
 #: diameter follows the mass at the fruit's density where the library has one.
 LOT_SPREADS = ("mass", "diameter", "modulus", "failure_stress", "bruise_susceptibility")
+#: Those that only a bruise criterion uses (not drawn without one).
+_BRUISE_SPREADS = ("failure_stress", "bruise_susceptibility")
 
 
 @dataclass(frozen=True)
 class LotSpreads:
-    """What a lot of ``fruit`` varies by default: ``distributions`` ((input name, distribution) pairs:
-    each a normal about the library's value with sd = (high − low)/4, truncated to [low, high], the range
-    read as a ±2 sd band), ``diameter_density`` (the density [kg/m³] the diameter follows the mass at, or
-    None) and ``described``: one line per property varied or left fixed, for the output."""
+    """What a lot of ``fruit`` varies by default: ``distributions`` ((input name, distribution) pairs: each a
+    split normal with its median at the library's value and each side's sd half the distance to that end of
+    the library range, truncated to the range), ``diameter_density`` (the density [kg/m³] each fruit's
+    diameter follows its mass at, or None) and ``described``: one line per property, for the output."""
 
     fruit: str
     distributions: tuple
@@ -178,14 +180,19 @@ class LotSpreads:
     described: tuple
 
 
-def lot_spreads(fruit: str, fixed) -> LotSpreads:
+def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
     """The library spreads a lot of ``fruit`` is drawn from, leaving out the inputs in ``fixed`` (those the
-    user gave, as constants or distributions).  A property whose library range is one value (low = high)
-    stays that value; one the entry lacks is left to the inputs' own rules (a criterion needing it is
-    refused)."""
-    from .distributions import TruncNormal
+    user gave, as constants or distributions; a given ``stiffness`` fixes the contact, so the modulus is not
+    drawn) and, without a bruise criterion (``bruise`` False), the failure stress and susceptibility.  A
+    property whose library range is one value stays that value; one the entry lacks is left to the inputs' own
+    rules (a criterion needing it is refused).  The diameter follows each fruit's mass (drawn here or given)
+    at the library density unless the diameter is given.  ``fruit`` must be a library name."""
+    from .distributions import SplitNormal
 
-    entry = library.fruits()[fruit]
+    entries = library.fruits()
+    if fruit not in entries:
+        raise ValueError(f"fruit must be one of {', '.join(entries)}; got {fruit!r}")
+    entry = entries[fruit]
     fixed = set(fixed)
     out, lines, density = [], [], None
     for name in LOT_SPREADS:
@@ -193,10 +200,14 @@ def lot_spreads(fruit: str, fixed) -> LotSpreads:
         if name in fixed:
             lines.append(f"{name}: as given")
             continue
+        if name in _BRUISE_SPREADS and not bruise:
+            continue
+        if name == "modulus" and "stiffness" in fixed:
+            lines.append("modulus: not drawn (the given stiffness fixes the contact)")
+            continue
         if value is None:
             continue
-        if name == "diameter" and "mass" not in fixed and entry.density is not None \
-                and any(n == "mass" for n, _ in out):
+        if name == "diameter" and entry.density is not None:
             density = entry.density.value
             lines.append(f"diameter: from each fruit's mass at the {fruit} density {density:g} kg/m³ "
                          f"(d = (6 m/(π ρ))^(1/3))")
@@ -204,10 +215,11 @@ def lot_spreads(fruit: str, fixed) -> LotSpreads:
         if not value.low < value.high:
             lines.append(f"{name}: {value.value:g} {value.unit} (the library gives no spread)")
             continue
-        sd = (value.high - value.low) / 4.0
-        out.append((name, TruncNormal(value.value, sd, value.low, value.high)))
-        lines.append(f"{name}: normal({value.value:g}, sd {sd:.3g}) in [{value.low:g}, {value.high:g}] {value.unit} "
-                     f"(the {fruit} library range as ±2 sd)")
+        low_sd, high_sd = (value.value - value.low) / 2.0, (value.high - value.value) / 2.0
+        out.append((name, SplitNormal(value.value, low_sd, high_sd, value.low, value.high)))
+        lines.append(f"{name}: median {value.value:g}, sd {low_sd:.3g} below and {high_sd:.3g} above, in "
+                     f"[{value.low:g}, {value.high:g}] {value.unit} (the {fruit} library value and range, "
+                     f"each side a ±2 sd band)")
     return LotSpreads(fruit, tuple(out), density, tuple(lines))
 
 

@@ -62,9 +62,14 @@ def usage_message(exc: ValueError) -> str:
     argument = getattr(exc, "argument", None)
     if isinstance(argument, tuple):  # a conflict between inputs given together
         return conflict_message([option_of(name) for name in argument])
-    if isinstance(argument, str) and argument in INPUTS:
+    if isinstance(argument, str) and (argument in INPUTS or argument in COMMAND_ARGUMENTS):
         return f"argument {option_of(argument)}: {exc}"
     return str(exc)
+
+
+#: Library arguments of the commands that are not table inputs but are CLI options of the same name
+#: (``drop``'s ``bounces`` and ``max_impacts``, ``line``'s ``alternatives``).
+COMMAND_ARGUMENTS = ("bounces", "max_impacts", "alternatives")
 
 
 def _library_call(func, *args, **kwargs):
@@ -224,16 +229,19 @@ def add_spread_option(parser) -> None:
                              "from the fruit's library spreads (by default a lot varies; giving an option fixes it)")
 
 
-def lot_distributions(args, fruit: str | None, given: list[str]):
+def lot_distributions(args, fruit: str | None, given: list[str], criterion: str | None):
     """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
-    (the default fruit when None): the library spreads of the inputs not in ``given`` (issue 14 item 4),
-    none with ``--no-spreads``."""
+    (the default fruit when None): the library spreads of the inputs not in ``given`` (issue 14 item 4; the
+    bruise inputs only with a criterion), none with ``--no-spreads``."""
     from ..presets import lot_spreads
 
     fruit = fruit or INPUTS["fruit"].default
     if args.no_spreads:
         return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",)
-    spreads = lot_spreads(fruit, given)
+    try:
+        spreads = lot_spreads(fruit, given, bruise=criterion not in (None, "none"))
+    except ValueError as exc:
+        raise UsageError(f"argument --fruit: {exc}") from None
     return spreads.distributions, spreads.diameter_density, spreads.described
 
 

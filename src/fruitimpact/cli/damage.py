@@ -6,6 +6,7 @@ import math
 import sys
 
 from ..quantities import INPUTS, OUTPUTS
+from ..registries import REGISTRIES as REGISTRY_INPUTS
 from .common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
                      dump_json, lot_distributions, print_spreads)
 
@@ -203,19 +204,22 @@ def cmd_line(args) -> int:
             distributions.append((quantity.name, parse_distribution(spec, quantity.dimension, quantity.name)))
         except ValueError as exc:
             raise UsageError(f"argument {quantity.option}: {exc}") from None
-    spreads, density, spread_lines = lot_distributions(args, constants.get("fruit"), [n for n, _ in distributions])
+    from .runs import _check_text
+
+    for name, value in constants.items():
+        if name in REGISTRY_INPUTS:
+            _check_text(name, [value])
+    spreads, density, spread_lines = lot_distributions(args, constants.get("fruit"), [n for n, _ in distributions],
+                                                       criterion)
     distributions += list(spreads)
     source = runs.PopulationSource(tuple(distributions), (), rows, seed, density)
     members, _ = source.inputs(0, rows, None)
     members.pop("model", None)
     alternatives = () if args.alternatives.strip().lower() == "none" else \
-        tuple(a.strip() for a in args.alternatives.split(",") if a.strip())
-    from ..registries import SURFACE_CHOICES
-
-    unknown = [a for a in alternatives if a not in SURFACE_CHOICES or a in ("rigid", "fruit")]
-    if unknown:
-        raise UsageError(f"argument --alternatives: {unknown[0]!r} is not a library surface; give names from "
-                         f"fruitimpact surfaces (comma-separated) or none")
+        tuple(a.strip() for a in args.alternatives.split(","))
+    if any(not a for a in alternatives):
+        raise UsageError(f"argument --alternatives: give library surface names, comma-separated, or none; got "
+                         f"{args.alternatives!r}")
     report = _library_call(audit, points, members, rows, criterion, constants, alternatives)
     _print_warnings("line", report["warnings"])
     report["seed"] = seed

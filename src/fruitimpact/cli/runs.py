@@ -166,7 +166,9 @@ def _check_constants(constants: dict, text: dict, given=()) -> None:
     first = message.split(" ", 1)[0]
     if str(probe["status"].iloc[0]) != "invalid" or first in _DEPENDENT_INPUTS:
         return
-    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given) and "must be given" in message):
+    # a refusal naming an input nobody gave is one the constants cause (a threshold the energy criterion needs,
+    # a failure stress the fruit lacks): it would refuse every member
+    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
         raise UsageError(_with_option(message))
 
 
@@ -311,7 +313,8 @@ def cmd_population(args) -> int:
             constants[dest] = dist.value
     _check_conflicts([d for d, _ in distributions])
     _check_constants(constants, text, [d for d, _ in distributions] + list(text))
-    spreads, density, spread_lines = lot_distributions(args, text.get("fruit"), [d for d, _ in distributions])
+    spreads, density, spread_lines = lot_distributions(args, text.get("fruit"), [d for d, _ in distributions],
+                                                       text.get("criterion"))
     distributions += list(spreads)
     try:
         names = runs.characteristics_list(args.characteristics) if args.characteristics else runs.DEFAULT_SUMMARY

@@ -45,9 +45,10 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
     rows = criterion.shape[0]
     out = {name: np.full(rows, np.nan) for name in ("bruise_margin", "bruised", "bruise_volume", "bruise_depth",
                                                    "bruise_width")}
-    out["bruise_energy"] = np.array(threshold_energy, dtype=float, copy=True)
-    # laws with a force at first touch (Kelvin–Voigt) have no finite Hertz pressure: no stress criterion there
-    finite = valid & np.isfinite(peak_pressure) & np.isfinite(fruit_energy)
+    out["bruise_energy"] = np.where(valid, np.asarray(threshold_energy, dtype=float), np.nan)
+    # a law without a Hertz pressure (Kelvin–Voigt: NaN) has no stress criterion; the energy criterion needs none
+    energy_ok = valid & np.isfinite(fruit_energy)
+    finite = energy_ok & np.isfinite(peak_pressure)
     shear_ok = finite & (poisson >= 0.0) & (poisson <= 0.5)
     everywhere = bool(shear_ok.all())
     nu = poisson if everywhere else poisson[shear_ok]
@@ -65,7 +66,8 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
     for code, name in enumerate(CRITERION_NAMES):
         if name == "none":
             continue
-        rows_of = np.flatnonzero(finite & (criterion == code) & (shear_ok if name == "shear" else True))
+        rows_of = np.flatnonzero((energy_ok if name == "energy" else finite) & (criterion == code)
+                                 & (shear_ok if name == "shear" else True))
         if rows_of.size == 0:
             continue
         margin = bruise.CRITERIA[name].margin(
@@ -78,7 +80,7 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
         if name != "energy":  # the fruit energy at the stress criterion's onset (module docstring)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 onset = fruit_energy[rows_of] * (1.0 + margin) ** -5.0
-            threshold = np.maximum(threshold, np.where(bruised, onset, 0.0))
+            threshold = np.maximum(threshold, np.where(np.isfinite(onset), onset, 0.0))
             out["bruise_energy"][rows_of] = threshold
         energy = volume_energy[rows_of]
         if volume_energy is not fruit_energy:  # the threshold on the susceptibility's basis

@@ -97,6 +97,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
     if bounces not in BOUNCE_RULES:
         raise InputError(f"bounces must be one of {', '.join(BOUNCE_RULES)}; got {bounces!r}", "bounces")
+    if bounces == "constant" and any(inputs.get(name) is not None for name in ("alpha", "damping")):
+        raise InputError("bounces constant recalibrates every impact to one restitution: give restitution (with "
+                         "alpha or damping the law sets e at each speed, which is bounces material)", "bounces")
     if not (isinstance(max_impacts, int) and 1 <= max_impacts <= 1000):
         raise InputError(f"max_impacts must be an integer in [1, 1000]; got {max_impacts!r}", "max_impacts")
     if inputs.get("surface") == "fruit":

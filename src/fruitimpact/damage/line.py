@@ -117,8 +117,17 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     difference)."""
     from ..batch import evaluation
     from ..constants import STANDARD_GRAVITY
+    from ..library import surfaces
     from ..validation import InputError
 
+    if isinstance(alternatives, str) or not all(isinstance(a, str) for a in alternatives):
+        raise InputError("alternatives must be a sequence of library surface names", "alternatives")
+    cushions = [name for name, entry in surfaces().items() if entry.partner is None]
+    unknown = [a for a in alternatives if a not in cushions]
+    if unknown:
+        raise InputError(f"alternatives must be library surfaces ({', '.join(cushions)}); got {unknown[0]!r}",
+                         "alternatives")
+    alternatives = tuple(dict.fromkeys(alternatives))  # each once, in the order given
     bruised_any = np.zeros(rows, dtype=bool)
     volume_total = np.zeros(rows)
     valid_so_far = np.ones(rows, dtype=bool)  # fruit computed at every point so far: the cumulation's population

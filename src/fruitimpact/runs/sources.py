@@ -434,7 +434,7 @@ class PopulationSource:
                 columns[name] = np.full(stop - start, dist.value)
             else:
                 columns[name] = self._stream(start, stop, stream_number(name), dist.draw)
-        if self.diameter_density is not None:
+        if self.diameter_density is not None and "mass" in columns:
             columns["diameter"] = np.cbrt(6.0 * columns["mass"] / (np.pi * self.diameter_density))
         for name, value in self.text:
             columns[name] = Labels.constant(value, stop - start)
