@@ -42,15 +42,16 @@ def test_every_input_of_the_table_is_a_batch_column():
         value = quantity.default if quantity.default is not None else {
             "stiffness": 8e5, "velocity": 1.0, "drop_height": 0.1, "restitution": 0.5, "alpha": 0.1,
             "damping": 1e5, "bioyield_force": 20.0, "failure_stress": 3e5, "bruise_susceptibility": 4e-6,
-            "bruise_energy": 0.05, "surface_crush_stress": 2e5}[name]
+            "bruise_energy": 0.05, "surface_crush_stress": 2e5, "bruise_width_ratio": 1.4}[name]
         # bruise inputs mean something only with a criterion; a layer only with a finite thickness
-        extra = {"criterion": ["energy"]} if name in ("failure_stress", "bruise_susceptibility", "bruise_energy") \
+        extra = {"criterion": ["energy"]} if name in ("failure_stress", "bruise_susceptibility", "bruise_energy",
+                                                      "bruise_width_ratio") \
             else {"surface_thickness": [0.01], "surface_modulus": [1e6]} if name == "surface_model" \
             else {"surface": ["cardboard"]} if name == "surface_crush_stress" else {}
         if name == "surface_model":
             value = "layer"
         result = evaluate({name: [value], **extra} if name != "bruise_energy" else {name: [value], **extra})
-        if name in ("failure_stress", "bruise_susceptibility"):
+        if name in ("failure_stress", "bruise_susceptibility", "bruise_width_ratio"):
             result = evaluate({"failure_stress": [3e5], name: [value], "criterion": ["pressure"]})
         assert result.loc[0, "status"] == "ok", (name, result.loc[0, "message"])
 

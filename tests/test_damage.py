@@ -567,3 +567,20 @@ def test_an_estimated_onset_energy_is_said():
                             "yield_pressure": [math.inf, 3.2e5]})
     assert "Hertz-scaling estimate" not in frame.loc[0, "warnings"]
     assert "Hertz-scaling estimate" in frame.loc[1, "warnings"]
+
+
+def test_the_bruise_width_ratio_is_the_fruits_own():
+    """Issue 14 item 5d: the contact-to-bruise width ratio 1.4 was measured on pears (Stropek & Gołacki 2020)
+    and was applied to every fruit.  Now: pear w = 2a/1.4 (the cap of that width holding the volume sets the
+    depth, Johnson-free geometry: V = π d (3w² + 4d²)/24); an apple has no ratio of its own, so its bruise
+    depth and width are unknown (NaN, a warning) unless one is given."""
+    frame = batch.evaluate({"fruit": ["pear", "apple", "apple"], "criterion": ["energy"] * 3,
+                            "bruise_energy": [0.01] * 3, "drop_height": [0.2] * 3,
+                            "bruise_width_ratio": [None, None, 2.0]})
+    pear, apple, given = (frame.loc[k] for k in range(3))
+    assert pear["bruise_width"] == pytest.approx(2 * pear["contact_radius"] / 1.4, rel=1e-12)
+    w, d = pear["bruise_width"], pear["bruise_depth"]
+    assert math.pi * d * (3 * w ** 2 + 4 * d ** 2) / 24 == pytest.approx(pear["bruise_volume"], rel=1e-9)
+    assert apple["bruise_volume"] > 0 and math.isnan(apple["bruise_width"]) and math.isnan(apple["bruise_depth"])
+    assert "bruise_width_ratio is not in the apple entry" in apple["warnings"]
+    assert given["bruise_width"] == pytest.approx(given["contact_radius"], rel=1e-12)

@@ -52,7 +52,7 @@ OUTPUT_COLUMNS = INPUT_OUTPUTS + LAW_COLUMNS + CHARACTERISTIC_COLUMNS + DAMAGE_N
 #: Thinnest cushion the layer model takes [m]: below it the pad is a coating (use a half-space).
 MIN_LAYER_THICKNESS = 0.5e-3
 #: Bruise inputs that mean nothing without a criterion.
-BRUISE_INPUTS = ("failure_stress", "bruise_susceptibility", "bruise_energy")
+BRUISE_INPUTS = ("failure_stress", "bruise_susceptibility", "bruise_energy", "bruise_width_ratio")
 #: Contact radius / effective radius beyond which Hertz's theory is left: the paraboloid that
 #: replaces the sphere in Hertz's solution is then more than (a/R)²/4 = 4 % off at the contact edge.
 HERTZ_RANGE = 0.4
@@ -483,6 +483,13 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
                 warnings.add(lacking & (resolved.fruit_of == fruit),
                              f"bruise_susceptibility is not in the {fruit} entry of the fruit library: bruise onset is "
                              f"judged, bruise volume is not (give --bruise-susceptibility [m^3/J], e.g. 3e-6)")
+            lacking = where & resolved.missing["bruise_width_ratio"] & ~given["bruise_width_ratio"] \
+                & ~messages.flagged
+            for fruit in sorted(set(resolved.fruit_of[lacking])):
+                warnings.add(lacking & (resolved.fruit_of == fruit),
+                             f"bruise_width_ratio is not in the {fruit} entry of the fruit library (measured on "
+                             f"pears only): bruise depth and width are unknown (give --bruise-width-ratio, the "
+                             f"contact width over the bruise width, e.g. 1.4)")
         if name == "shear":
             poisson = used["poisson"]
             messages.set(where & ~((poisson >= 0.0) & (poisson <= 0.5)) & ~messages.flagged,
@@ -559,7 +566,8 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
                                   fruit_energy=threshold_energy, volume_energy=volume_energy,
                                   failure_stress=used["failure_stress"], threshold_energy=threshold,
                                   susceptibility=used["bruise_susceptibility"],
-                                  contact_radius=out[:, CONTACT_RADIUS], valid=done))
+                                  contact_radius=out[:, CONTACT_RADIUS], valid=done,
+                                  width_ratio=used["bruise_width_ratio"]))
     return {name: columns[name] for name in (*DAMAGE_NAMES, "bruise_energy")}
 
 

@@ -42,6 +42,7 @@ __all__ = ["ENERGY_BASED", "ENERGY_BASES", "FRUIT_UNITS", "SURFACE_MODELS", "SUR
 FRUIT_UNITS = {
     "mass": "kg", "diameter": "m", "density": "kg/m^3", "modulus": "Pa", "poisson": "", "failure_stress": "Pa",
     "restitution": "", "alpha": "s/m", "bruise_susceptibility": "m^3/J", "bruise_threshold_energy": "J",
+    "bruise_width_ratio": "",
 }
 #: The numeric fields of a surface and their SI units.
 SURFACE_UNITS = {"modulus": "Pa", "poisson": "", "thickness": "m", "radius": "m", "crush_stress": "Pa"}
@@ -56,7 +57,7 @@ _FRUIT_REQUIRED = ("mass", "diameter", "modulus", "poisson")
 ENERGY_BASED = ("bruise_susceptibility", "bruise_threshold_energy")
 ENERGY_BASES = ("impact", "absorbed")
 _POSITIVE = {"mass", "diameter", "density", "modulus", "failure_stress", "alpha", "bruise_susceptibility",
-             "bruise_threshold_energy", "thickness", "radius"}
+             "bruise_threshold_energy", "bruise_width_ratio", "thickness", "radius"}
 
 
 class LibraryError(ValueError):
@@ -137,6 +138,8 @@ class Fruit:
         Bruise volume per unit energy [m³/J] (1 cm³/J = 1e-6 m³/J).
     bruise_threshold_energy : Value or None
         Energy below which no bruise formed [J].
+    bruise_width_ratio : Value or None
+        Contact width over the width of the bruise it leaves [-] (pear: 1.4).
     """
 
     name: str
@@ -153,6 +156,7 @@ class Fruit:
     alpha: Value | None
     bruise_susceptibility: Value | None
     bruise_threshold_energy: Value | None
+    bruise_width_ratio: Value | None = None
 
     def values(self) -> dict[str, Value]:
         """The known numeric properties, by field name."""
@@ -163,7 +167,7 @@ class Fruit:
         where known ``failure_stress`` [Pa], ``bruise_susceptibility`` [m³/J], ``bruise_threshold_energy``
         [J], ``restitution`` [-] (central values, confirmed or not)."""
         names = ("mass", "diameter", "modulus", "poisson", "failure_stress", "bruise_susceptibility",
-                 "bruise_threshold_energy", "restitution")
+                 "bruise_threshold_energy", "restitution", "bruise_width_ratio")
         return {name: getattr(self, name).value for name in names if getattr(self, name) is not None}
 
     def bases(self) -> dict[str, str]:

@@ -85,7 +85,7 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     for name, value in DAMAGE_DEFAULTS.items():
         defaults[name] = value
     no_threshold = np.ones(rows, dtype=bool)
-    missing = {name: np.zeros(rows, dtype=bool) for name in (*DAMAGE_DEFAULTS, "restitution")}
+    missing = {name: np.zeros(rows, dtype=bool) for name in (*DAMAGE_DEFAULTS, "restitution", "bruise_width_ratio")}
     impact_basis = {name: np.zeros(rows, dtype=bool) for name in ("bruise_susceptibility", "bruise_energy")}
     fruit_of = np.full(rows, "", dtype=object)
     restitution = default_restitution
@@ -98,8 +98,9 @@ def resolve(inputs, default_restitution: float) -> Resolved:
         where = slice(None) if single else fruit_labels.codes == code
         fruit_of[where] = name
         entry = fruits[name].inputs()
-        if entry.get("restitution") is None:
-            missing["restitution"][where] = True
+        for key in ("restitution", "bruise_width_ratio"):
+            if entry.get(key) is None:
+                missing[key][where] = True
         for key in DAMAGE_DEFAULTS:
             if key != "bruise_energy" and entry.get(_LIBRARY_KEYS.get(key, key)) is None:
                 defaults.put(key, where, math.nan, single)

@@ -205,6 +205,11 @@ INPUTS: dict[str, Quantity] = _table(
              "bruise volume per joule of absorbed energy above the threshold (default: the --fruit's own; "
              "without one the bruise volume is unknown)",
              NON_NEGATIVE, Range(1e-7, 5e-5, True, True), None, "--bruise-susceptibility"),
+    Quantity("bruise_width_ratio", "", "contact-to-bruise width ratio", "dimensionless", "", 1.0,
+             "contact width over the width of the bruise it leaves: sets the bruise width 2a/ratio and, with the "
+             "volume, its depth (default: the --fruit's own, measured on pears only: 1.4; without one the bruise "
+             "depth and width are unknown)",
+             POSITIVE, Range(0.5, 5.0, True, True), None, "--bruise-width-ratio"),
     Quantity("bruise_energy", "W_th", "bruise threshold energy W_th", "energy", "mJ", 1e3,
              "absorbed energy at bruise onset, subtracted from the fruit's energy in the bruise volume: the "
              "energy criterion's threshold (default: the --fruit's); under a stress criterion the fruit "

@@ -17,8 +17,9 @@ The rules (docs/damage.md):
   the onset energy is W_f (threshold/quantity)⁵ exactly.  On a cushion layer
   or with plastic contact p0 does not scale so; there it is the same Hertz
   estimate (docs/damage.md says so);
-* the bruise is a spherical cap of width 2a/1.4 (a the contact radius; pear data,
-  Stropek & Gołacki 2020) holding that volume, which fixes its depth.
+* the bruise is a spherical cap of width 2a/ratio (a the contact radius, the ratio
+  the fruit's own contact-to-bruise width ratio: pear 1.4, Stropek & Gołacki 2020;
+  unknown for the others) holding that volume, which fixes its depth.
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ CRITERION_NAMES = ("none", "pressure", "shear", "energy")
 
 
 def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energy, failure_stress,
-                   threshold_energy, susceptibility, contact_radius, valid, volume_energy=None) -> dict[str, np.ndarray]:
+                   threshold_energy, susceptibility, contact_radius, valid, volume_energy=None,
+                   width_ratio=bruise.CONTACT_TO_BRUISE_WIDTH) -> dict[str, np.ndarray]:
     """``max_shear_stress``, ``bruise_margin``, ``bruised``, ``bruise_volume``, ``bruise_depth``,
     ``bruise_width`` and ``bruise_energy`` (the threshold W_th the volume used) of every row (arrays of the table's length; NaN where no criterion applies or
     the row is not ``valid``).  ``criterion`` holds indices into ``CRITERION_NAMES``.  ``fruit_energy`` [J] is
@@ -87,7 +89,8 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
             with np.errstate(divide="ignore", invalid="ignore"):
                 threshold = np.where(threshold > 0.0, threshold * energy / fruit_energy[rows_of], 0.0)
         volume = bruise.bruise_volume(energy, susceptibility[rows_of], threshold, bruised)
-        depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of])
+        ratio = np.broadcast_to(np.asarray(width_ratio, dtype=float), (rows,))[rows_of]
+        depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of], ratio)
         out["bruise_volume"][rows_of] = volume
         out["bruise_depth"][rows_of] = depth
         out["bruise_width"][rows_of] = width

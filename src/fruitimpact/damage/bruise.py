@@ -430,13 +430,14 @@ def cap_depth(volume, width):
     return depth[()]
 
 
-def bruise_geometry(volume, contact_radius):
+def bruise_geometry(volume, contact_radius, width_ratio=CONTACT_TO_BRUISE_WIDTH):
     """Bruise depth and width [m] from the bruise volume and the peak contact radius.
 
-    width = 2 a / 1.4: Stropek & Gołacki (2020, Postharvest Biol. Technol. 163:111120) measured, for
-    pears at their three highest impact speeds, a contact width about 1.4 times the bruise width. That is
-    pear data, applied here to every fruit. depth: the spherical cap of that width holding the volume
-    (``cap_depth``). Zero volume gives zero depth and width.
+    width = 2 a / ``width_ratio``, the ratio of the contact width to the bruise width it leaves, measured per
+    fruit (pear: 1.4 at the three highest impact speeds of Stropek & Gołacki 2020, Postharvest Biol. Technol.
+    163:111120; the library holds it per fruit and no fruit borrows another's: NaN gives an unknown width
+    and depth).  depth: the spherical cap of that width holding the volume (``cap_depth``).  Zero volume
+    gives zero depth and width.
 
     Parameters
     ----------
@@ -444,6 +445,8 @@ def bruise_geometry(volume, contact_radius):
         Bruise volume [m³], ≥ 0 (e.g. ``bruise_volume``).
     contact_radius : float or array
         Peak Hertz contact radius a [m], ≥ 0.
+    width_ratio : float or array
+        Contact width / bruise width [-], > 0, or NaN (unknown).
 
     Returns
     -------
@@ -451,8 +454,10 @@ def bruise_geometry(volume, contact_radius):
     """
     v = _values("volume", volume, 0.0, unit="m³")
     a = _values("contact_radius", contact_radius, 0.0, unit="m")
-    v, a = np.broadcast_arrays(v, a)
-    width = np.where(v == 0.0, 0.0, np.where(np.isnan(v), np.nan, (2.0 / CONTACT_TO_BRUISE_WIDTH) * a))
+    ratio = np.asarray(width_ratio, dtype=float)
+    v, a, ratio = np.broadcast_arrays(v, a, ratio)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        width = np.where(v == 0.0, 0.0, np.where(np.isnan(v), np.nan, 2.0 * a / ratio))
     return cap_depth(v, width), width[()]
 
 
