@@ -108,8 +108,8 @@ def damage_benchmarks(record, quick: bool) -> None:
     points = [TransferPoint("bin tipper", 0.3, "rubber-belt"), TransferPoint("conveyor", 0.05, "pvc-belt"),
               TransferPoint("singulator", 0.1, "steel"), TransferPoint("table", 0.08, "foam-pad", True),
               TransferPoint("carton", 0.15, "cardboard")]
-    audit(points[:1], {k: v[:10] for k, v in members.items()}, 10, "shear", {})
-    line_time = best_of(lambda: audit(points, members, n, "shear", {}), 1)
+    audit(points[:1], {k: v[:10] for k, v in members.items()}, 10, "shear", {}, ())
+    line_time = best_of(lambda: audit(points, members, n, "shear", {}, ()), 1)
 
     def evaluate_all():
         for p in points:
@@ -119,6 +119,25 @@ def damage_benchmarks(record, quick: bool) -> None:
     floor = best_of(evaluate_all, 1)
     record(f"line audit, {n:,} fruit × 5 transfer points", line_time, "batch.evaluate of the same impacts", floor,
            "s", "incidence, volumes, cumulation", of_baseline=True)
+
+    # issue 14 item 9: the line against one population of its N·P impacts (one table, every point's rows
+    # together: what `population` evaluates), and plastic contact against elastic on the same line
+    stacked = {k: np.concatenate([v] * len(points)) for k, v in members.items()}
+    stacked["drop_height"] = np.concatenate([np.full(n, p.drop_height) for p in points])
+    stacked["surface"] = np.concatenate([np.full(n, "fruit" if p.fruit_on_fruit else p.surface, dtype=object)
+                                         for p in points])
+    stacked["criterion"] = np.full(n * len(points), "shear", dtype=object)
+    population = best_of(lambda: evaluation(stacked), 1)
+    record(f"line audit against one population of its {n * len(points):,} impacts (goal ≤ 1.5×)", line_time,
+           "batch.evaluate of the N·P impacts as one table", population, "s", "issue 14 item 9", of_baseline=True)
+    plastic = {**members, "yield_pressure": np.full(n, 3.2e5)}
+    audit(points[:1], {k: v[:10] for k, v in plastic.items()}, 10, "shear", {}, ())
+    plastic_time = best_of(lambda: audit(points, plastic, n, "shear", {}, ()), 1)
+    record(f"line audit with plastic contact (p_y 0.32 MPa), {n:,} × 5 (goal ≤ 2× elastic)", plastic_time,
+           "the same line elastic", line_time, "s", "issue 14 item 9", of_baseline=True)
+    alternatives = best_of(lambda: audit(points, members, n, "shear", {}, ("foam-pad",)), 1)
+    record(f"line audit with --alternatives foam-pad, {n:,} × 5", alternatives, "the same line without",
+           line_time, "s", "one evaluation per point and alternative", of_baseline=True)
 
 
 if __name__ == "__main__":
