@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from . import contact
+from . import contact, library
 from .contact import hertz_contact_duration
 from .calibrate import TABLE_E_MIN
 from .calibrate import damping_factor as calibrated_damping_factor
@@ -152,6 +152,33 @@ def _check_text(inputs: InputColumns, messages: MessageBook) -> None:
                              name)
 
 
+def _resolve_preset_criterion(inputs: InputColumns, messages: MessageBook) -> None:
+    """``criterion preset``: each row takes the criterion its fruit's library entry names (issue 14 item 5c);
+    a fruit without one is refused, naming ``--criterion``."""
+    criteria = inputs.text["criterion"]
+    preset = criteria.mask("preset")
+    if not preset.any():
+        return
+    fruits = library.fruits()
+    labels = list(criteria.labels)
+    codes = criteria.codes.copy()
+    fruit_labels = inputs.text["fruit"]
+    for code, name in enumerate(fruit_labels.labels):
+        rows = preset & (fruit_labels.codes == code)
+        if not rows.any():
+            continue
+        chosen = fruits[name].criterion if name in fruits else None
+        if chosen is None:
+            messages.set(rows & ~messages.flagged,
+                         f"criterion preset: the {name} entry of the fruit library names no bruise criterion the "
+                         f"literature supports: give --criterion pressure, shear or energy", "criterion")
+            chosen = "none"
+        if chosen not in labels:
+            labels.append(chosen)
+        codes[rows] = labels.index(chosen)
+    inputs.text["criterion"] = Labels(codes, tuple(labels))
+
+
 def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> None:
     which = [j for j in inputs.given_inputs() if INPUTS[NUMERIC_INPUTS[j]].plausible is not None]
     if not which:
@@ -184,6 +211,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     codes = {name: inputs.text[name].codes for name in REGISTRIES}
     uniques = {name: inputs.text[name].labels for name in REGISTRIES}
     _check_text(inputs, messages)
+    _resolve_preset_criterion(inputs, messages)
     _plausibility(inputs, warnings, detail)
 
     # an input nobody gave is its default on every row: a fill, not a select over the whole matrix

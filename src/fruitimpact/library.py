@@ -140,6 +140,10 @@ class Fruit:
         Energy below which no bruise formed [J].
     bruise_width_ratio : Value or None
         Contact width over the width of the bruise it leaves [-] (pear: 1.4).
+    criterion, criterion_source, criterion_note : str
+        The bruise criterion the literature read supports for this fruit (``pressure``, ``shear`` or
+        ``energy``; None where none was found), where that was read and what it rests on
+        (``--criterion preset`` takes it).
     """
 
     name: str
@@ -157,6 +161,9 @@ class Fruit:
     bruise_susceptibility: Value | None
     bruise_threshold_energy: Value | None
     bruise_width_ratio: Value | None = None
+    criterion: str | None = None
+    criterion_source: str = ""
+    criterion_note: str = ""
 
     def values(self) -> dict[str, Value]:
         """The known numeric properties, by field name."""
@@ -323,8 +330,15 @@ def fruits() -> Mapping[str, Fruit]:
         modulus_kind = row["modulus_kind"].strip()
         if not modulus_kind:
             raise LibraryError(f"{where}: modulus_kind must say which modulus is stored")
+        criterion = (row.get("criterion") or "").strip() or None
+        if criterion is not None and criterion not in ("pressure", "shear", "energy"):
+            raise LibraryError(f"{where}: criterion must be pressure, shear or energy (or empty); got {criterion!r}")
+        if criterion is not None and not (row.get("criterion_source") or "").strip():
+            raise LibraryError(f"{where}: criterion has no source")
         table[name] = Fruit(name=name, description=row["description"].strip(), modulus_kind=modulus_kind,
-                            source=row["source"].strip(), **values)
+                            source=row["source"].strip(), criterion=criterion,
+                            criterion_source=(row.get("criterion_source") or "").strip(),
+                            criterion_note=(row.get("criterion_note") or "").strip(), **values)
     return MappingProxyType(table)
 
 

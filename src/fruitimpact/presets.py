@@ -224,6 +224,23 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
     return LotSpreads(fruit, tuple(out), density, tuple(lines))
 
 
+def fruit_criterion(fruit: str | None, criterion: str | None) -> str:
+    """The bruise criterion to use: ``criterion`` as given, or, when it is None or ``preset``, the one the
+    literature supports for ``fruit`` (its library entry; the default fruit when None).  ValueError naming
+    ``criterion`` when that fruit has none (a command that needs a criterion refuses then)."""
+    if criterion not in (None, "preset"):
+        return criterion
+    name = fruit or INPUTS["fruit"].default
+    entry = library.fruits().get(name)
+    if entry is None or entry.criterion is None:
+        from .validation import InputError
+
+        raise InputError(f"criterion must be given: the {name} entry of the fruit library names no bruise criterion "
+                         f"the literature supports (pressure, shear or energy; the onset height changes by an "
+                         f"order of magnitude between them)", "criterion")
+    return entry.criterion
+
+
 def effective_mass(mass, partner_mass):
     """Reduced mass m m_2/(m + m_2) [kg]; a fixed surface (m_2 = inf) leaves m."""
     mass = np.asarray(mass, dtype=float)
@@ -232,6 +249,6 @@ def effective_mass(mass, partner_mass):
         return np.where(np.isinf(partner_mass), mass, mass * partner_mass / (mass + partner_mass))
 
 
-__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
+__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
            "lot_spreads", "resolve"]
 assert all(name in INPUTS for name in DAMAGE_DEFAULTS) and math.isfinite(DAMAGE_DEFAULTS["failure_stress"])

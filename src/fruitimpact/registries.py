@@ -26,6 +26,8 @@ CRITERION_CHOICES = MappingProxyType({
     "pressure": "peak contact pressure p_0 >= failure stress σ_f",
     "shear": "largest subsurface shear stress τ_max >= σ_f / 2 (Tresca, Hertz's field for the fruit's ν)",
     "energy": "energy absorbed by the fruit >= threshold W_th",
+    "preset": "the criterion the literature supports for the --fruit (fruitimpact fruits: apple shear, potato "
+              "pressure); refused for a fruit without one",
 })
 
 #: ``--bruise-basis``: the energy a given bruise susceptibility and threshold energy were measured on.

@@ -184,9 +184,13 @@ def cmd_line(args) -> int:
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
     criterion = args.criterion
-    if criterion in (None, "none"):
-        raise UsageError("argument --criterion: required for a line audit: pressure, shear or energy (the onset "
+    if criterion == "none":
+        raise UsageError("argument --criterion: a line audit needs one: pressure, shear or energy (the onset "
                          "height changes by an order of magnitude between them)")
+    from ..presets import fruit_criterion
+
+    # none given: the one the literature supports for the --fruit (issue 14 item 5c)
+    criterion = _library_call(fruit_criterion, getattr(args, "fruit", None), criterion)
     _check_outputs([("--plot", args.plot, "figure")])
     rows = _count("-n/--rows", args.rows, 1, 10_000_000)
     seed = _count("--seed", args.seed, 0)

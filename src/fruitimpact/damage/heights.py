@@ -118,10 +118,15 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     unknown = [name for name in inputs if name not in INPUTS]
     if unknown:
         raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
+    from ..presets import fruit_criterion
+
     criterion = inputs.get("criterion")
-    if criterion in (None, "none"):
+    if criterion == "none":
         raise InputError("criterion must be given for a safe height: pressure, shear or energy (the onset height "
                          "changes by an order of magnitude between them)", "criterion")
+    # none given: the criterion the literature supports for the fruit (issue 14 item 5c), named in the result
+    inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), criterion)}
+    criterion = inputs["criterion"]
     given = {name: value for name, value in inputs.items() if value is not None}
     _check_row(given)
     names = SENSITIVITY_INPUTS.get(criterion, ())
