@@ -328,14 +328,36 @@ def _piece(a, b, first_touch, F_star, unloading, mass, c, energy, p, nodes, weig
     ``first_touch``: F = w^6 (w from a^(1/6) to b^(1/6)), smooth against the F^(−1/3) (Hertz) and
     F^(−1/2) (layer) slopes of F = 0, on [0, b] or just above it.  Otherwise F = F* − s²: 1/v grows like (F* − F)^(−1/2) towards the turn F*, and the
     substitution makes the integrand smooth on every piece, however close to the turn it ends."""
-    total = 0.0
-    if first_touch:
-        u_low = a ** (1.0 / 6.0)
-        width = b ** (1.0 / 6.0) - u_low
-    else:
+    if not first_touch:
         s_high = math.sqrt(F_star - a)
         s_low = math.sqrt(max(F_star - b, 0.0))
-        width = s_high - s_low
+        if 0.0 < 2.0 * s_low < s_high:
+            # a piece ending at a kink just below the turn (F* − F_b ≪ F* − a): there 1/v changes on the
+            # scale s ~ √(F* − F_b) (the energy left at the kink is first order in F* − F_b, below it the
+            # slope of the kinked piece takes over), so the s-range is cut geometrically, each cut resolving it
+            total = 0.0
+            low = s_low
+            while low < s_high:
+                high = min(2.0 * low, s_high)
+                total += _quadrature(low, high, first_touch, F_star, unloading, mass, c, energy, p, nodes, weights)
+                low = high
+            return total
+        return _quadrature(s_low, s_high, first_touch, F_star, unloading, mass, c, energy, p, nodes, weights)
+    return _quadrature(a ** (1.0 / 6.0), b ** (1.0 / 6.0), first_touch, F_star, unloading, mass, c, energy, p, nodes,
+                       weights)
+
+
+@nb.njit(**_JIT)
+def _quadrature(low, high, first_touch, F_star, unloading, mass, c, energy, p, nodes, weights):
+    """Gauss–Legendre of (dδ/dF)/|v| over one range of the substituted variable: w from ``low`` to ``high``
+    with F = w^6 (``first_touch``), else s with F = F* − s² (``_piece``)."""
+    total = 0.0
+    if first_touch:
+        u_low = low
+        width = high - low
+    else:
+        s_low = low
+        width = high - low
     for j in range(nodes.shape[0]):
         u = 0.5 * (nodes[j] + 1.0)  # on (0, 1)
         if first_touch:  # F = w^6, w from a^(1/6) to b^(1/6): smooth against F^(−1/3), F^(−1/2) at F = 0
