@@ -102,7 +102,8 @@ def test_drop_energy_is_conserved_and_plastic_work_only_on_the_first_impact():
     for before, after in zip(impacts, impacts[1:]):
         assert after["velocity"] == pytest.approx(before["restitution"] * before["velocity"], rel=1e-12)
     assert impacts[0]["plastic_work"] > 0.0
-    assert all(i["plastic_work"] == 0.0 for i in impacts[1:])  # the same spot reloads elastically (Thornton)
+    # the flattened spot reloads elastically while its Hertz pressure stays under p_y, then yields again
+    assert all(i["plastic_work"] < 0.1 * impacts[0]["plastic_work"] for i in impacts[1:])
     assert impacts[0]["velocity"] == pytest.approx(math.sqrt(2 * G * 0.1), rel=1e-12)
     # the rebound height of the last impact is below the rest height (1 mm)
     assert impacts[-1]["exit_velocity"] ** 2 / (2 * G) < 1e-3
@@ -606,3 +607,17 @@ def test_each_fruit_has_the_criterion_its_literature_supports():
     frame = batch.evaluate({"fruit": ["apple", "pear"], "criterion": ["preset"] * 2, "drop_height": [0.1] * 2})
     assert frame.loc[0, "criterion"] == "shear" and frame.loc[0, "status"] == "ok"
     assert frame.loc[1, "status"] == "invalid" and "--criterion" in frame.loc[1, "message"]
+
+
+def test_a_flattened_spot_never_carries_more_than_the_yield_pressure():
+    """Issue 14 item 8 (the defect): the later impacts of a drop reloaded the flattened spot as Hertz on R_p with
+    no limit, and Thornton's unloading profile at F* peaks at 3F* p_y/(2F* + F_y), up to 1.5 p_y: more than the
+    flesh carries.  Pure Thornton (model hertz, no viscous stress), 30 cm onto steel: every impact's contact
+    pressure is at most p_y (to rounding), the spot yielding again where the reload would pass it; energy still
+    balances (released = absorbed + left)."""
+    report = drop(0.3, model="hertz", yield_pressure=3.2e5, fruit="apple")
+    impacts = report["impacts"]
+    assert len(impacts) > 2
+    assert all(i["max_pressure"] <= 3.2e5 * (1 + 1e-9) for i in impacts)
+    released = impacts[0]["velocity"] ** 2 / 2 * 0.18
+    assert report["total_absorbed_energy"] + report["energy_left"] == pytest.approx(released, rel=1e-9)

@@ -41,8 +41,9 @@ MAX_IMPACTS = 50
 #: The fruit is at rest once a rebound would rise less than this [m].
 REST_HEIGHT = 1e-3
 #: Accumulation rule, named in every output.
-ACCUMULATION_RULE = ("same spot; later impacts reload the flattened spot elastically along Thornton's unloading "
-                     "curve (no new plastic work); each impact meeting the criterion adds BS (W_f - W_th)+")
+ACCUMULATION_RULE = ("same spot; later impacts reload the flattened spot (Hertz with its radius R_p) up to the "
+                     "yield pressure p_y and yield again beyond it; each impact meeting the criterion adds "
+                     "BS (W_f - W_th)+")
 
 _IMPACT_FIELDS = ("velocity", "restitution", "exit_velocity", "peak_force", "time_to_peak", "contact_duration",
                   "max_deflection", "max_pressure", "max_shear_stress", "absorbed_energy", "plastic_work",
@@ -133,10 +134,8 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             status = "failed" if code == 2 else "inaccurate"
             message = f"impact {len(impacts)}: {result.messages.text(0)}"
             break
-        if flattened is None and result.plastic_block is not None and result.plastic[0]:
-            radius_p = float(result.plastic_block[0, -1])
-            if columns["permanent_deflection"] > 0.0:
-                flattened = radius_p
+        if result.plastic_block is not None and result.plastic[0] and columns["permanent_deflection"] > 0.0:
+            flattened = float(result.plastic_block[0, -1])  # the spot as this impact left it: R_p
         rebound = columns["exit_velocity"]
         if rebound * rebound / (2.0 * STANDARD_GRAVITY) < rest_height or len(impacts) >= max_impacts:
             if len(impacts) >= max_impacts and rebound * rebound / (2.0 * STANDARD_GRAVITY) >= rest_height:
@@ -148,9 +147,11 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         next_row = {**row, "velocity": velocity}
         next_row.pop("drop_height")
         if flattened is not None:
-            # the same, flattened spot: Hertz with R_p (same E*), elastic up to the force already reached
-            next_row.pop("yield_pressure", None)
+            # the same, flattened spot: Hertz with R_p (same E*), and the same limiting pressure p_y: a reload
+            # whose Hertz pressure on R_p would pass p_y yields again (Thornton's elastic reload up to F* would
+            # carry up to 1.5 p_y there, 3F* p_y/(2F* + F_y): more than the flesh's limit)
             next_row.pop("bioyield_force", None)
+            next_row["yield_pressure"] = float(first.columns["yield_pressure"][0])
             next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
             next_row["diameter"] = 2.0 * flattened
         if bounces == "material" and material_factor > 0.0:
