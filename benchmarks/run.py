@@ -2,6 +2,10 @@
 
     python benchmarks/run.py [--quick] [--markdown FILE]
 
+It also runs the signal-path benchmarks (signals.py, signals_fit.py, scorecard.py, latency.py and
+analyze_memory.py --quick), which print their own tables; the one-hour memory run of analyze_memory.py is a
+command of its own (37 min).
+
 Each line compares fruitimpact with the obvious baseline doing the same job:
 SciPy ``solve_ivp`` (DOP853, rtol 1e-10, terminal event at δ = 0, peak force by
 a root of dF/dt on the dense output) and the paper's RK4 at 1e-4 s.  Accuracy
@@ -324,6 +328,20 @@ def main(argv=None):
     from damage import damage_benchmarks
 
     damage_benchmarks(record, args.quick)
+
+    # ------------------------------------------------------------------ sorting lines (issues 8, 13)
+    # the signal-path benchmarks print their own tables (each figure beside its baseline or goal in the same run);
+    # --quick runs their small sizes; the 1 h memory run is `python benchmarks/analyze_memory.py` (37 min) alone
+    here = Path(__file__).parent
+    for script, options in (("signals.py", ["--quick"] if args.quick else []),
+                            ("signals_fit.py", []),
+                            ("scorecard.py", ["--quick"] if args.quick else []),
+                            ("latency.py", ["--quick"] if args.quick else []),
+                            ("analyze_memory.py", ["--quick"])):
+        print(f"\n=== benchmarks/{script} {' '.join(options)}", flush=True)
+        done = subprocess.run([sys.executable, str(here / script), *options])
+        if done.returncode not in (0, 1):  # 1: a goal missed, which the script's own table shows
+            print(f"benchmarks/{script} ended with status {done.returncode}", flush=True)
 
     # ------------------------------------------------------------------ CLI
     exe = shutil.which("fruitimpact")
