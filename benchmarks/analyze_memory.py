@@ -99,7 +99,6 @@ import itertools
 import json
 import math
 import os
-import platform
 import shlex
 import shutil
 import signal
@@ -116,6 +115,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import linegen as lg  # noqa: E402  (tests/linegen.py: the independent generator)
+from bench_common import console_script, machine  # noqa: E402
 
 #: Issue 13 item 4: analyze's peak resident memory for any length [MB].
 GOAL_RSS_MB = 400.0
@@ -324,14 +324,6 @@ def first_difference(a: Path, b: Path) -> str | None:
     return None
 
 
-def console_script() -> str:
-    """The installed ``fruitimpact`` console script (beside this Python, else on PATH)."""
-    here = Path(sys.executable).with_name("fruitimpact")
-    found = str(here) if here.exists() else shutil.which("fruitimpact")
-    if not found:
-        raise SystemExit("fruitimpact console script not found: activate the venv (pip install -e .)")
-    return found
-
 
 def package_dir(env: dict) -> Path:
     """Where the console script's Python imports ``fruitimpact`` from, with this environment."""
@@ -378,25 +370,6 @@ def block_score(lines: list[str], truth: dict) -> str:
             f"({touching} touching another); recall {card['recall'] * 100:.1f} %, missed {card['missed']}, "
             f"extra {card['extra']}, rebounds taken for fruit {card['rebounds_taken_for_fruit']}, "
             f"fruit taken for rebounds {card['fruit_taken_for_rebounds']}")
-
-
-def machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        mem = int(next(l for l in Path("/proc/meminfo").read_text().splitlines()
-                       if l.startswith("MemTotal")).split()[1]) / 1024 ** 2
-        mem_text = f"{mem:.0f} GiB RAM"
-    except (OSError, StopIteration, ValueError):
-        mem_text = "RAM unknown"
-    return (f"{cpu}, {os.cpu_count()} cores, {mem_text}; {platform.system()} {platform.release()}; "
-            f"Python {platform.python_version()}, NumPy {np.__version__}")
 
 
 def table(runs: list[Run]) -> list[list[str]]:

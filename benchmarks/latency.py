@@ -91,10 +91,8 @@ import hashlib
 import json
 import math
 import os
-import platform
 import re
 import shlex
-import shutil
 import signal
 import socket
 import subprocess
@@ -110,6 +108,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import linegen as lg  # noqa: E402  (tests/linegen.py: the independent generator)
+from bench_common import console_script, machine  # noqa: E402
 
 #: Issue 13 item 3: p99 of (line written − contact's last sample fed) [ms].
 GOAL_P99_MS = 20.0
@@ -189,14 +188,6 @@ def make_recording(label: str, name: str, size: int) -> Recording:
 # One run of the stream, fed at real time
 # ---------------------------------------------------------------------------------------------------------------
 
-def console_script() -> str:
-    beside = Path(sys.executable).with_name("fruitimpact")
-    found = str(beside) if beside.exists() else shutil.which("fruitimpact")
-    if not found:
-        sys.exit("console script 'fruitimpact' not found (pip install -e .)")
-    return found
-
-
 class Reader(threading.Thread):
     """Reads a file descriptor to its end; ``lines``: (arrival [perf_counter s], bytes) per complete line."""
 
@@ -259,6 +250,14 @@ def _feed(blocks: list[bytes], send, start: float) -> tuple[np.ndarray, np.ndarr
     return written, deadlines
 
 
+def _result(argv, proc, out, err, written, deadlines, eof, cpu, load) -> dict:
+    """One run's record, once its readers have drained the process's output."""
+    out.join(10)
+    err.join(10)
+    return dict(argv=argv, code=proc.returncode, lines=out.lines, stderr=b"\n".join(l for _, l in err.lines),
+                written=written, deadlines=deadlines, eof=eof, cpu=cpu, load=load)
+
+
 def run_pipe(rec: Recording, fit: bool) -> dict:
     """(a) samples on stdin."""
     argv = [console_script(), "stream", *rec.options(fit)]
@@ -285,10 +284,7 @@ def run_pipe(rec: Recording, fit: bool) -> dict:
     finally:
         if proc.poll() is None:
             proc.kill()
-    out.join(10)
-    err.join(10)
-    return dict(argv=argv, code=proc.returncode, lines=out.lines, stderr=b"\n".join(l for _, l in err.lines),
-                written=written, deadlines=deadlines, eof=eof, cpu=(cpu1 - cpu0) / (eof - start), load=load)
+    return _result(argv, proc, out, err, written, deadlines, eof, (cpu1 - cpu0) / (eof - start), load)
 
 
 def run_tcp(rec: Recording, fit: bool) -> dict:
@@ -331,10 +327,7 @@ def run_tcp(rec: Recording, fit: bool) -> dict:
     finally:
         if proc.poll() is None:
             proc.kill()
-    out.join(10)
-    err.join(10)
-    return dict(argv=argv, code=proc.returncode, lines=out.lines, stderr=b"\n".join(l for _, l in err.lines),
-                written=written, deadlines=deadlines, eof=eof, cpu=(cpu1 - cpu0) / (eof - start), load=load)
+    return _result(argv, proc, out, err, written, deadlines, eof, (cpu1 - cpu0) / (eof - start), load)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -452,19 +445,6 @@ def table(rows: list[dict], markdown: bool = False) -> str:
         return "  ".join(v.rjust(w) if i > 2 else v.ljust(w) for i, (v, w) in enumerate(zip(c, widths)))
 
     return "\n".join([line(HEADERS), line(["-" * w for w in widths])] + [line(c) for c in cells])
-
-
-def machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for text in Path("/proc/cpuinfo").read_text().splitlines():
-            if text.startswith("model name"):
-                cpu = text.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return (f"{platform.system()} {platform.release()}, {cpu}, {os.cpu_count()} CPUs, "
-            f"Python {platform.python_version()}")
 
 
 def source_state() -> str:

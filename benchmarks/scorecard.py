@@ -29,7 +29,6 @@ import argparse
 import json
 import math
 import platform
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -40,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import linegen as lg  # noqa: E402  (tests/linegen.py: the independent generator)
+from bench_common import console_script  # noqa: E402
 
 #: Columns: (header, key in the scorecard, format, goal key or None).
 COLUMNS = [
@@ -57,14 +57,6 @@ COLUMNS = [
     ("overlaps", "overlaps", "{}", None),
     ("time", "time", "{:.1f} s", None),
 ]
-
-
-def console_script() -> str:
-    beside = Path(sys.executable).with_name("fruitimpact")
-    found = str(beside) if beside.exists() else shutil.which("fruitimpact")
-    if not found:
-        sys.exit("console script 'fruitimpact' not found (pip install -e .)")
-    return found
 
 
 def run_scenario(scenario: lg.Scenario, size: int, folder: Path) -> dict:

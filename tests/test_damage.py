@@ -17,6 +17,7 @@ from fruitimpact import batch
 from fruitimpact.damage.drops import drop
 from fruitimpact.damage.heights import safe_height
 from fruitimpact.damage.line import TransferPoint, audit, read_line
+from fruitimpact.library import fruits
 
 G = 9.80665
 APPLE = dict(mass=0.115, diameter=0.065, modulus=3e6, poisson=0.37)
@@ -286,13 +287,11 @@ def test_a_safe_height_that_cannot_be_found_is_not_a_result(cli):
 
 # ---------------------------------------------------------------- issue 14 item 1: no fruit borrows another's values
 def _library_value(fruit, key):
-    from fruitimpact.library import fruits
-
     value = fruits()[fruit].inputs().get(key)
     return math.nan if value is None else value
 
 
-@pytest.mark.parametrize("fruit", sorted(__import__("fruitimpact.library", fromlist=["fruits"]).fruits()))
+@pytest.mark.parametrize("fruit", sorted(fruits()))
 def test_each_fruit_uses_only_its_own_damage_values(fruit):
     """The rule, checked on every library entry: a fruit's failure stress and bruise susceptibility are its own
     library values; where its entry has none, a stress criterion is refused naming --failure-stress (before:
@@ -333,8 +332,6 @@ def test_bruise_volume_grows_from_zero_at_the_stress_onset(criterion):
     root search (an independent path: Illinois on ln h to 1e-9) and the energy of a drop at fixed e on the
     basis the apple's susceptibility was measured on (impact, ½ m V² = m g h; absorbed would add (1 − e²)); so
     above onset BV = BS m g (h − h_s) exactly, and 0 just below it."""
-    from fruitimpact.library import fruits
-
     assert fruits()["apple"].bases() == {"bruise_susceptibility": "impact", "bruise_threshold_energy": "impact"}
     hs = safe_height(criterion=criterion, fruit="apple", sensitivity=False)["safe_height"]
     heights = [0.999 * hs, 1.001 * hs, 2.0 * hs, 10.0 * hs]
@@ -366,14 +363,9 @@ def test_each_bruise_value_is_applied_on_the_energy_its_source_measured():
     mixed = batch.evaluate({"criterion": ["energy"], "drop_height": [h], "fruit": ["pear"], "bruise_energy": [0.05],
                             "bruise_basis": ["impact"]})
     m, ee = mixed.loc[0, "mass"], mixed.loc[0, "restitution"]
-    assert fruits_basis("pear") == "absorbed"
+    assert fruits()["pear"].bases()["bruise_susceptibility"] == "absorbed"
     assert mixed.loc[0, "bruise_volume"] == pytest.approx(3e-6 * (m * G * h - 0.05) * (1.0 - ee ** 2), rel=1e-9)
 
-
-def fruits_basis(name):
-    from fruitimpact.library import fruits
-
-    return fruits()[name].bases()["bruise_susceptibility"]
 
 
 def test_a_drop_keeps_the_fruit_damping_and_e_follows_the_law():
@@ -419,8 +411,6 @@ def test_a_population_draws_the_fruit_library_spreads_unless_fixed(cli, tmp_path
     susceptibility are drawn from the library ranges (normal about the value, sd = range/4, truncated to the
     range) and the diameter follows the mass at the library density: every member satisfies
     m = ρ π d³/6 exactly (float rounding), and each drawn input stays in its library range."""
-    from fruitimpact.library import fruits
-
     apple = fruits()["apple"]
     out = tmp_path / "members.csv"
     cli.ok("population", "-n", "2000", "--fruit", "apple", "--drop-height", "4cm", "--criterion", "shear",
@@ -508,7 +498,8 @@ def test_cardboard_protects_only_below_its_crush():
 # ------------------------------------------------------- defects found by the review of issue 14 (helper attack)
 @pytest.mark.parametrize("argv, option", [
     (("population", "-n", "50", "--fruit", "pear", "--drop-height", "4cm", "--criterion", "shear"), "--failure-stress"),
-    (("sweep", "--fruit", "pear", "--criterion", "shear", "--velocity", "0.5:1:3", "-o", "sw.csv"), "--failure-stress"),
+    (("sweep", "--fruit", "pear", "--criterion", "shear", "--velocity", "0.5:1:3", "-o", "{tmp}/sw.csv"),
+     "--failure-stress"),
     (("line", "examples/line.csv", "--fruit", "banana", "--criterion", "shear", "-n", "10"), "--fruit"),
     (("line", "examples/line.csv", "--fruit", "apple", "--criterion", "shear", "-n", "10", "--alternatives", ""),
      "--alternatives"),
@@ -518,11 +509,12 @@ def test_cardboard_protects_only_below_its_crush():
      "--surface-crush-stress"),
     (("drop", "--drop-height", "30cm", "--alpha", "0.3", "--bounces", "constant"), "--bounces"),
 ])
-def test_issue14_options_refuse_what_they_cannot_do(cli, argv, option, monkeypatch):
+def test_issue14_options_refuse_what_they_cannot_do(cli, argv, option, monkeypatch, tmp_path):
     import pathlib
 
-    monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])
-    assert option in cli.error(*argv)
+    monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])  # examples/line.csv; outputs go to tmp_path
+    assert option in cli.error(*(a.format(tmp=tmp_path) for a in argv))
+    assert not list(tmp_path.iterdir())  # refused before any work: nothing written
 
 
 def test_a_lot_without_a_criterion_draws_no_bruise_inputs(cli):
@@ -541,7 +533,7 @@ def test_the_lot_median_is_the_library_value():
     for fruit in ("apple", "peach", "potato"):
         for name, dist in lot_spreads(fruit, []).distributions:
             draws = dist.draw(np.random.default_rng(2), 100_000)
-            value = getattr(__import__("fruitimpact.library", fromlist=["fruits"]).fruits()[fruit], name)
+            value = getattr(fruits()[fruit], name)
             # the median of 1e5 draws is within ~0.4 % of the sd of the true median; 2 % of the range is ample
             assert abs(np.median(draws) - value.value) < 0.02 * (value.high - value.low), (fruit, name)
             assert draws.min() >= value.low and draws.max() <= value.high
@@ -595,8 +587,6 @@ def test_each_fruit_has_the_criterion_its_literature_supports():
     pendulum tests see none at 22 N (Fu et al. 2016) and 30 mm (Komarnicki & Stopa 2013); the shear criterion
     (a subsurface stress, Yuwana & Duprat 1998) puts the onset above both.  The library names it per fruit and
     `--criterion preset` (and safe-height / line without --criterion) takes it; a fruit with none is refused."""
-    from fruitimpact.library import fruits
-
     assert fruits()["apple"].criterion == "shear" and fruits()["pear"].criterion is None
     preset = safe_height(fruit="apple", sensitivity=False)
     assert preset["criterion"] == "shear"

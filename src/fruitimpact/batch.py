@@ -168,11 +168,11 @@ def _resolve_preset_criterion(inputs: InputColumns, messages: MessageBook) -> No
         if not rows.any():
             continue
         chosen = fruits[name].criterion if name in fruits else None
-        if chosen is None:
+        if chosen is None:  # refused; the row keeps the "preset" it was given
             messages.set(rows & ~messages.flagged,
                          f"criterion preset: the {name} entry of the fruit library names no bruise criterion the "
                          f"literature supports: give --criterion pressure, shear or energy", "criterion")
-            chosen = "none"
+            continue
         if chosen not in labels:
             labels.append(chosen)
         codes[rows] = labels.index(chosen)

@@ -70,7 +70,6 @@ for the indices (``signals.indices``) and a model fit.
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 
