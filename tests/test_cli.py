@@ -469,3 +469,29 @@ def test_sigint_to_the_console_script_never_shows_a_traceback(delay):
     assert process.returncode in (0, 130), (process.returncode, err)
     if process.returncode == 130:
         assert err.strip().endswith("interrupted") and len(err.strip().splitlines()) == 1
+
+
+def test_an_interrupt_swallowed_by_a_c_callback_is_delivered_again():
+    """Python reports a KeyboardInterrupt raised inside a ctypes callback (numba's LLVM object cache, seen on
+    CI when Ctrl-C hit the first compilation) as "Exception ignored" and goes on; the console script's hook
+    must deliver it again in Python code, so that the user's Ctrl-C is obeyed with its one line."""
+    import signal
+    import sys
+    import time
+    import types
+
+    import fruitimpact.cli as package
+
+    saved_hook, saved_alarm = sys.unraisablehook, signal.getsignal(signal.SIGALRM)
+    try:
+        package._redeliver_interrupts_from_callbacks()
+        sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=KeyboardInterrupt(),
+                                                 exc_traceback=None, err_msg=None, object=None))
+        with pytest.raises(KeyboardInterrupt):
+            deadline = time.monotonic() + 2.0
+            while time.monotonic() < deadline:  # the timer is 5 ms; 2 s only bounds a failure
+                time.sleep(0.001)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        sys.unraisablehook = saved_hook
+        signal.signal(signal.SIGALRM, saved_alarm)

@@ -37,6 +37,29 @@ def _command(argv) -> str | None:
     return next((token for token in argv if token in COMMANDS), None)
 
 
+def _redeliver_interrupts_from_callbacks() -> None:
+    """A Ctrl-C that lands inside a C callback (numba's LLVM object cache notifies Python through ctypes)
+    cannot propagate: Python prints "Exception ignored ... Traceback ... KeyboardInterrupt" and goes on.
+    Swallowing it would ignore the user; it is delivered again 5 ms later by a one-shot timer (SIGALRM,
+    which nothing else here uses), by then back in Python code, where ``main`` answers it with its one
+    line and exit status 130.  Raising it inside the hook itself would only be reported as ignored too."""
+    import signal
+
+    default_hook = sys.unraisablehook
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    def hook(unraisable):
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            signal.signal(signal.SIGALRM, interrupt)
+            signal.setitimer(signal.ITIMER_REAL, 0.005)
+            return
+        default_hook(unraisable)
+
+    sys.unraisablehook = hook
+
+
 def main(argv=None) -> int:
     """Run ``fruitimpact ARGV``; returns the exit status (0 ok, 1 a result not ok, 2 bad input,
     130 interrupted)."""
@@ -46,6 +69,7 @@ def main(argv=None) -> int:
         from .common import UsageError, _attach_negative_values, _numba_without_blas
 
         if console:
+            _redeliver_interrupts_from_callbacks()
             _numba_without_blas()
         parser = build_parser()
         argv = _attach_negative_values(argv)
