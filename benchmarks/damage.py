@@ -91,8 +91,8 @@ def damage_benchmarks(record, quick: bool) -> None:
         record(f"Thornton batch {label}, {rows:,} impacts (2 cores)", rows / elapsed, "loop of solve_ivp 1e-10",
                scipy_rate, "impacts/s", f"max |Δe| vs DOP853 1e-12: {err:.1e}")
 
-    from fruitimpact.batch import evaluation
-    from fruitimpact.damage.heights import safe_height
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.handling.heights import safe_height
 
     safe_height(criterion="shear", fruit="apple", sensitivity=False)
     search = best_of(lambda: safe_height(criterion="shear", fruit="apple", sensitivity=False), 5)
@@ -100,7 +100,7 @@ def damage_benchmarks(record, quick: bool) -> None:
     record("safe-height root search (shear, library apple)", search * 1e3, "one batch.evaluate of that row",
            one * 1e3, "ms", "Illinois on ln h to 1e-9", of_baseline=True)
 
-    from fruitimpact.damage.line import TransferPoint, audit
+    from fruitimpact.handling.line import TransferPoint, audit
 
     n = 20_000 if quick else 200_000
     members = {"mass": rng.normal(0.18, 0.02, n), "modulus": rng.lognormal(math.log(3e6), 0.15, n),

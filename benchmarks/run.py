@@ -176,11 +176,11 @@ def numpy_floor(columns):
 
 def end_to_end(record, quick):
     """The commands and calls users run, each against its floor in the same run (issue 6, section 5)."""
-    from fruitimpact.batch import evaluate
-    from fruitimpact.calibrate import damping_factor
+    from fruitimpact.impact.evaluation import evaluate
+    from fruitimpact.physics.calibrate import damping_factor
     from fruitimpact.engine.adaptive import adaptive_characteristics
-    from fruitimpact.calibrate import law_params
-    from fruitimpact.models import DAMPING_LAWS
+    from fruitimpact.physics.calibrate import law_params
+    from fruitimpact.physics import DAMPING_LAWS
 
     n_eval = 200_000 if quick else 2_000_000
     columns = fruit_columns(n_eval)
@@ -293,9 +293,9 @@ def main(argv=None):
            scipy_rate, "impacts/s", f"max rel. err (grid read-off): {rk4_err:.1e}")
 
     # ------------------------------------------------------------------ other laws (compiled adaptive)
-    from fruitimpact.calibrate import damping_factor, law_params
+    from fruitimpact.physics.calibrate import damping_factor, law_params
     from fruitimpact.engine.adaptive import adaptive_characteristics
-    from fruitimpact.models import DAMPING_LAWS
+    from fruitimpact.physics import DAMPING_LAWS
 
     n_other = 100_000 if args.quick else 1_000_000
     e_other = np.random.default_rng(2).uniform(0.3, 0.9, n_other)

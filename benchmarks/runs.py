@@ -53,7 +53,7 @@ def batch(rows: int, repeats: int, folder: Path) -> list[tuple]:
     import pyarrow.parquet as pq
 
     from fruitimpact import runs
-    from fruitimpact.batch import evaluate
+    from fruitimpact.impact.evaluation import evaluate
     from fruitimpact.cli import main
 
     source = folder / "in.csv"
@@ -82,9 +82,9 @@ def batch(rows: int, repeats: int, folder: Path) -> list[tuple]:
 
 def population(rows: int, repeats: int, folder: Path) -> list[tuple]:
     from fruitimpact import runs
-    from fruitimpact.batch import evaluate
+    from fruitimpact.impact.evaluation import evaluate
     from fruitimpact.cli import main
-    from fruitimpact.distributions import parse_distribution
+    from fruitimpact.impact.distributions import parse_distribution
 
     specs = {"mass": ("normal(115g,10g)", "mass"), "velocity": ("uniform(0.5,1.5)", "velocity"),
              "modulus": ("lognormal(3MPa,0.2)", "modulus"),

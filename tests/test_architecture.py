@@ -14,11 +14,11 @@ from pathlib import Path
 import pytest
 
 from fruitimpact import Characteristics, simulate
-from fruitimpact.batch import OUTPUT_COLUMNS, evaluate
+from fruitimpact.impact.evaluation import OUTPUT_COLUMNS, evaluate
 from fruitimpact.cli import build_parser
 from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS
-from fruitimpact.quantities import CHARACTERISTIC_NAMES, INPUTS, OUTPUTS
-from fruitimpact.validation import InputError
+from fruitimpact.impact.quantities import CHARACTERISTIC_NAMES, INPUTS, OUTPUTS
+from fruitimpact.impact.validation import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "src" / "fruitimpact"
@@ -94,9 +94,26 @@ def test_no_family_dispatch_by_if_chains_outside_the_engine():
     assert not offenders, offenders
 
 
+def test_the_package_root_holds_topic_packages_only():
+    """Issue 15 item 1: no loose module at the root; every topic is a package with a docstring that says
+    what it holds (the reader's map)."""
+    loose = sorted(p.name for p in SOURCE.glob("*.py") if p.name not in ("__init__.py", "__main__.py"))
+    assert not loose, loose
+    packages = sorted(p for p in SOURCE.iterdir() if p.is_dir() and p.name != "__pycache__")
+    assert {p.name for p in packages} >= {"cli", "damage", "engine", "handling", "impact", "library", "physics",
+                                          "plotting", "reference", "runs", "signals"}
+    for package in packages:
+        init = package / "__init__.py"
+        assert init.is_file(), package
+        import ast
+        assert ast.get_docstring(ast.parse(init.read_text())), f"{package.name}/__init__.py has no docstring"
+
+
 def test_import_contracts_hold():
-    """The import-linter contracts of pyproject.toml (the numeric core imports no pandas, matplotlib,
-    pyarrow, CLI, runs or plotting; plotting only where figures are drawn)."""
+    """The import-linter contracts of pyproject.toml: the layers (cli > reference | runs > plotting >
+    handling | signals > impact > damage | library > physics > engine: no package imports one above or
+    beside it, so no two import each other), the numeric core imports no pandas, pyarrow, SciPy or
+    matplotlib, and matplotlib stays out of every computing package."""
     lint = Path(sys.executable).with_name("lint-imports")
     command = [str(lint)] if lint.exists() else [sys.executable, "-m", "importlinter.cli"]
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=300)
@@ -112,3 +129,25 @@ def test_help_starts_no_numba_and_no_pandas():
     loaded = dict(line.split() for line in done.stdout.splitlines()
                   if len(line.split()) == 2 and line.split()[1] in ("True", "False"))
     assert loaded == {"numba": "False", "pandas": "False", "matplotlib": "False", "pyarrow": "False"}, done.stdout
+
+
+def test_every_model_in_the_index_exists():
+    """docs/architecture.md's index from a published model to its implementation: every dotted name in it
+    imports (a renamed function breaks the reader's one step, so it breaks this test)."""
+    import importlib
+
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    index = text[text.index("## Find a published model"):]
+    names = re.findall(r"`(fruitimpact(?:\.\w+)+)`", index)
+    assert len(names) >= 25, names
+    for name in names:
+        module, attribute = name.rsplit(".", 1)
+        assert hasattr(importlib.import_module(module), attribute), name
+
+
+def test_the_tree_in_the_docs_is_the_tree_on_disk():
+    """docs/architecture.md draws the package tree; it lists every package and no package that is gone."""
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    drawn = set(re.findall(r"[├└]── (\w+)/", text))
+    on_disk = {p.name for p in SOURCE.iterdir() if p.is_dir() and (p / "__init__.py").is_file()}
+    assert drawn == on_disk, (drawn ^ on_disk)

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from fruitimpact import Fruit, simulate
-from fruitimpact.batch import curves, evaluate
+from fruitimpact.impact.evaluation import curves, evaluate
 from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS
 
 MODELS = ["hertz", "hunt-crossley", "chen", "flores", "exact", "kelvin-voigt", "kelvin-voigt-clamped",

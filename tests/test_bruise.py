@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fruitimpact.contact import effective_modulus, hertz_peak_pressure, hertz_stiffness
+from fruitimpact.physics.hertz import effective_modulus, hertz_peak_pressure, hertz_stiffness
 from fruitimpact.damage import bruise
 from fruitimpact.damage.bruise import (
     CONTACT_TO_BRUISE_WIDTH,
@@ -524,4 +524,4 @@ def test_module_is_pure_numerics():
             imported.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
             imported.add("." * node.level + (node.module or ""))
-    assert imported <= {"__future__", "math", "collections.abc", "dataclasses", "numpy", "..constants"}
+    assert imported <= {"__future__", "math", "collections.abc", "dataclasses", "numpy", "fruitimpact.physics.constants"}

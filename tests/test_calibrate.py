@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from fruitimpact import calibrate
-from fruitimpact.calibrate import (TABLE_E_MIN, achieved_restitution, damping_factor, exact_groups, group_table,
+from fruitimpact.physics import calibrate
+from fruitimpact.physics.calibrate import (TABLE_E_MIN, achieved_restitution, damping_factor, exact_groups, group_table,
                                    law_params)
 from fruitimpact.engine import codes
-from fruitimpact.models import DAMPING_LAWS, KUWABARA_KONO_C1
+from fruitimpact.physics import DAMPING_LAWS, KUWABARA_KONO_C1
 from test_engine_adaptive import clamped_kelvin_voigt_restitution
 
 TABULATED = ["tsuji-clamped", "kelvin-voigt-clamped", "kuwabara-kono", "kuwabara-kono-unclamped"]

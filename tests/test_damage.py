@@ -13,11 +13,11 @@ import math
 import numpy as np
 import pytest
 
-from fruitimpact import batch
-from fruitimpact.damage.drops import drop
-from fruitimpact.damage.heights import safe_height
-from fruitimpact.damage.line import TransferPoint, audit, read_line
-from fruitimpact.library import fruits
+from fruitimpact.impact import evaluation as batch
+from fruitimpact.handling.drops import drop
+from fruitimpact.handling.heights import safe_height
+from fruitimpact.handling.line import TransferPoint, audit, read_line
+from fruitimpact.library.catalogue import fruits
 
 G = 9.80665
 APPLE = dict(mass=0.115, diameter=0.065, modulus=3e6, poisson=0.37)
@@ -376,7 +376,7 @@ def test_a_drop_keeps_the_fruit_damping_and_e_follows_the_law():
     keeps e fixed; the material rule gives e rising as the fruit slows, as drop tests report."""
     from scipy.integrate import solve_ivp
 
-    from fruitimpact import batch as batch_module
+    from fruitimpact.impact import evaluation as batch_module
 
     report = drop(0.3, fruit="apple")
     assert report["bounces"] == "material"
@@ -528,7 +528,7 @@ def test_a_lot_without_a_criterion_draws_no_bruise_inputs(cli):
 def test_the_lot_median_is_the_library_value():
     """The spreads are split normals with their median at the library value (the library ranges are
     asymmetric about it: a symmetric normal truncated to the range moved the apple's median modulus 23 % up)."""
-    from fruitimpact.presets import lot_spreads
+    from fruitimpact.impact.presets import lot_spreads
 
     for fruit in ("apple", "peach", "potato"):
         for name, dist in lot_spreads(fruit, []).distributions:

@@ -19,7 +19,7 @@ import pytest
 from scipy.optimize import brentq
 
 import fruitimpact
-from fruitimpact.batch import evaluate
+from fruitimpact.impact.evaluation import evaluate
 from reference import reference_powerlaw
 
 STIFFNESS = 1.0e6  # N/m^1.5

@@ -17,8 +17,8 @@ import pyarrow as pa
 import pytest
 
 import fruitimpact
-from fruitimpact.batch import evaluate
-from fruitimpact.inputs import unknown_columns_message
+from fruitimpact.impact.evaluation import evaluate
+from fruitimpact.impact.inputs import unknown_columns_message
 
 
 def test_nan_is_invalid_and_none_takes_the_default():

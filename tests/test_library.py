@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from fruitimpact import library
-from fruitimpact.constants import JONATHAN_APPLE, JONATHAN_RESTITUTION
-from fruitimpact.library import LibraryError, fruit, fruits, surface, surfaces
+from fruitimpact.library import catalogue as library
+from fruitimpact.physics.constants import JONATHAN_APPLE, JONATHAN_RESTITUTION
+from fruitimpact.library.catalogue import LibraryError, fruit, fruits, surface, surfaces
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -30,7 +30,7 @@ HARD_SURFACES = ("steel", "concrete", "wood", "pvc-belt")
 
 def _raw(filename: str) -> list[dict[str, str]]:
     """The CSV rows read here independently of the library's loader."""
-    text = resources.files("fruitimpact").joinpath("data", filename).read_text(encoding="utf-8")
+    text = resources.files("fruitimpact.library").joinpath("data", filename).read_text(encoding="utf-8")
     return list(csv.DictReader(line for line in text.splitlines() if line.strip() and not line.startswith("#")))
 
 
@@ -342,13 +342,13 @@ def test_loader_refuses_broken_tables(monkeypatch, fresh_cache, filename, edit, 
 
 def test_package_data_ships_the_csvs():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    patterns = config["tool"]["setuptools"]["package-data"]["fruitimpact"]
+    patterns = config["tool"]["setuptools"]["package-data"]["fruitimpact.library"]
     for filename in ("data/fruits.csv", "data/surfaces.csv"):
-        assert (ROOT / "src" / "fruitimpact" / filename).is_file()
+        assert (ROOT / "src" / "fruitimpact" / "library" / filename).is_file()
         assert any(fnmatch.fnmatch(filename, pattern) for pattern in patterns), (filename, patterns)
 
 
 def test_the_library_stays_light():
-    code = ("import sys; import fruitimpact.library as L; L.fruits(); L.surfaces(); L.fruit_rows(); "
+    code = ("import sys; import fruitimpact.library.catalogue as L; L.fruits(); L.surfaces(); L.fruit_rows(); "
             "heavy = {'pandas', 'numpy', 'numba', 'pyarrow'} & set(sys.modules); assert not heavy, heavy")
     subprocess.run([sys.executable, "-c", code], check=True)

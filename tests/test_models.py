@@ -8,10 +8,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fruitimpact import Fruit, simulate
-from fruitimpact.calibrate import law_params
-from fruitimpact.comparison import restitution_table, unique_laws
+from fruitimpact.physics.calibrate import law_params
+from fruitimpact.reference.comparison import restitution_table, unique_laws
 from fruitimpact.engine import forces
-from fruitimpact.models import DAMPING_LAWS, KUWABARA_KONO_C1
+from fruitimpact.physics import DAMPING_LAWS, KUWABARA_KONO_C1
 
 APPLE = Fruit()
 K_APPLE = simulate(APPLE).law.stiffness

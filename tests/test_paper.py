@@ -5,7 +5,7 @@ allows 1 %: the printed forces carry ±0.5 % scatter, docs/paper.md)."""
 
 import pytest
 
-from fruitimpact.paper import load_table1, paper_report
+from fruitimpact.reference.paper import load_table1, paper_report
 
 
 @pytest.fixture(scope="module")

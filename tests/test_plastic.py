@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 from scipy.special import beta as beta_function
 from scipy.special import betainc
 
-from fruitimpact import batch
+from fruitimpact.impact import evaluation as batch
 from fruitimpact.engine.codes import CHARACTERISTIC_COLUMNS
 from fruitimpact.engine.plastic import (
     PLASTIC_COLUMNS,

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from fruitimpact import runs
-from fruitimpact.quantities import DEFAULT_SUMMARY
+from fruitimpact.impact.quantities import DEFAULT_SUMMARY
 
 
 class Interrupt:

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from fruitimpact.contact import rigid_plane_stiffness
+from fruitimpact.physics.hertz import rigid_plane_stiffness
 from fruitimpact.engine.powerlaw import (
     powerlaw_curves,
     powerlaw_single,

@@ -18,7 +18,7 @@ import math
 import numpy as np
 import pytest
 
-from fruitimpact.constants import STANDARD_GRAVITY as G
+from fruitimpact.physics.constants import STANDARD_GRAVITY as G
 from fruitimpact.engine.codes import RESTITUTION
 from fruitimpact.engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
 from fruitimpact.signals.analysis import Analysis

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import fruitimpact
-from fruitimpact.batch import evaluate
-from fruitimpact.models import DAMPING_LAWS
+from fruitimpact.impact.evaluation import evaluate
+from fruitimpact.physics import DAMPING_LAWS
 
 
 def test_rk4_rebound_into_the_surface_is_not_ok(cli):

@@ -1,4 +1,4 @@
-"""Unit parsing at the boundary: ``fruitimpact.units.parse_quantity``.
+"""Unit parsing at the boundary: ``fruitimpact.impact.units.parse_quantity``.
 
 The expected SI values below are written out by hand (not read from
 ``units.UNITS``) so that a wrong factor in the table is caught; a second test
@@ -11,7 +11,7 @@ import math
 
 import pytest
 
-from fruitimpact.units import SI_UNIT, UNITS, parse_quantity
+from fruitimpact.impact.units import SI_UNIT, UNITS, parse_quantity
 
 # (text, dimension, SI value) -- one row per unit the CLI documents, factors by hand.
 KNOWN = [

@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fruitimpact import batch
-from fruitimpact.damage.heights import safe_height
+from fruitimpact.impact import evaluation as batch
+from fruitimpact.handling.heights import safe_height
 
 G = 9.80665
 

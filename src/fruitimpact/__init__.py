@@ -1,8 +1,9 @@
 """fruitimpact: simulate and measure the impact of a fruit on a surface.
 
-Three layers: pure model functions (``contact``, ``models``, ``engine``),
-solvers and result objects (``solvers``, ``batch``, ``impact``), and the CLI,
-I/O and plots (``cli``, ``runs``, ``plotting``, ``paper``).  SI units throughout.
+Topic packages (docs/architecture.md): ``engine`` (compiled solvers), ``physics`` (Hertz contact, damping
+laws), ``damage`` (bruise criteria), ``library`` (fruits and surfaces), ``impact`` (quantities, validation,
+evaluate and simulate), ``handling`` (drops, safe heights, line audits), ``signals`` (force recordings),
+``plotting``, ``reference`` (the founding paper), ``runs`` (large runs) and ``cli``.  SI units throughout.
 
 The names below are imported on first use, so that ``import fruitimpact.cli``
 (and ``fruitimpact --help``) does not compile the engine.
@@ -15,12 +16,12 @@ import importlib
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "JONATHAN_SOURCE": "constants", "STANDARD_GRAVITY": "constants",
-    "Characteristics": "impact", "ContactLaw": "impact", "Curves": "impact", "Fruit": "impact",
-    "ImpactInputs": "impact", "ImpactResult": "impact", "Surface": "impact", "impact_velocity": "impact",
-    "simulate": "impact",
-    "CALIBRATIONS": "models", "DAMPING_LAWS": "models", "Calibration": "models", "DampingLaw": "models",
-    "SOLVERS": "solvers", "evaluate": "batch",
+    "JONATHAN_SOURCE": "physics.constants", "STANDARD_GRAVITY": "physics.constants",
+    "Characteristics": "impact.simulation", "ContactLaw": "impact.simulation", "Curves": "impact.simulation",
+    "Fruit": "impact.simulation", "ImpactInputs": "impact.simulation", "ImpactResult": "impact.simulation",
+    "Surface": "impact.simulation", "impact_velocity": "impact.simulation", "simulate": "impact.simulation",
+    "CALIBRATIONS": "physics", "DAMPING_LAWS": "physics", "Calibration": "physics", "DampingLaw": "physics",
+    "SOLVERS": "impact.solvers", "evaluate": "impact.evaluation",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

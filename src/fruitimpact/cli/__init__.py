@@ -20,8 +20,8 @@ COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population", "drop
 
 def build_parser():
     """The argparse parser of every command (built from the table of quantities)."""
-    from . import damage, reference, runs, signals, simulate
-    from .common import _Parser
+    from fruitimpact.cli import damage, reference, runs, signals, simulate
+    from fruitimpact.cli.common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -66,7 +66,7 @@ def main(argv=None) -> int:
     console = argv is None  # the console script; in-process callers keep numba's defaults
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        from .common import UsageError, _attach_negative_values, _numba_without_blas
+        from fruitimpact.cli.common import UsageError, _attach_negative_values, _numba_without_blas
 
         if console:
             _redeliver_interrupts_from_callbacks()

@@ -13,11 +13,11 @@ import math
 import re
 import sys
 
-from ..quantities import INPUTS, option_of
-from ..units import parse_quantity
-from ..validation import conflict_message
+from fruitimpact.impact.quantities import INPUTS, option_of
+from fruitimpact.impact.units import parse_quantity
+from fruitimpact.impact.validation import conflict_message
 
-from . import PROG  # noqa: E402,F401  (defined by the package first; the commands import it from here)
+from fruitimpact.cli import PROG  # noqa: E402,F401  (defined by the package first; the commands import it from here)
 
 
 class UsageError(Exception):
@@ -92,7 +92,7 @@ def _with_option(message: str) -> str:
 
 
 def _add_impact_options(parser: argparse.ArgumentParser) -> None:
-    from ..registries import REGISTRIES
+    from fruitimpact.impact.registries import REGISTRIES
 
     group = parser.add_argument_group("fruit and impact (plain numbers are SI; units accepted)")
     for quantity in INPUTS.values():
@@ -233,7 +233,7 @@ def lot_distributions(args, fruit: str | None, given: list[str], criterion: str 
     """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
     (the default fruit when None): the library spreads of the inputs not in ``given`` (issue 14 item 4; the
     bruise inputs only with a criterion), none with ``--no-spreads``."""
-    from ..presets import lot_spreads
+    from fruitimpact.impact.presets import lot_spreads
 
     fruit = fruit or INPUTS["fruit"].default
     if args.no_spreads:

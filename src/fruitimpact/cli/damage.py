@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 import sys
 
-from ..quantities import INPUTS, OUTPUTS
-from ..registries import REGISTRIES as REGISTRY_INPUTS
-from .common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
+from fruitimpact.impact.quantities import INPUTS, OUTPUTS
+from fruitimpact.impact.registries import REGISTRIES as REGISTRY_INPUTS
+from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
                      dump_json, lot_distributions, print_spreads)
 
 #: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
@@ -25,7 +25,7 @@ def _without_velocity(args) -> dict:
 
 
 def _check_outputs(pairs) -> None:
-    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
+    from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
 
     for option, path, kind in pairs:
         if path is not None:
@@ -42,7 +42,7 @@ def _print_warnings(command: str, warnings) -> None:
 
 # ----------------------------------------------------------------------------------------------- drop
 def cmd_drop(args) -> int:
-    from ..damage.drops import drop
+    from fruitimpact.handling.drops import drop
 
     kwargs = _without_velocity(args)
     height = kwargs.pop("drop_height", None)
@@ -87,9 +87,9 @@ def _risk_map(kwargs: dict, by: str):
     each column, from one evaluation of the whole grid and one root search."""
     import numpy as np
 
-    from ..batch import evaluation
-    from ..damage.heights import safe_heights
-    from ..registries import SURFACE_CHOICES
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.handling.heights import safe_heights
+    from fruitimpact.impact.registries import SURFACE_CHOICES
 
     heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
     if by == "surface":
@@ -119,7 +119,7 @@ def _risk_map(kwargs: dict, by: str):
 
 
 def cmd_safe_height(args) -> int:
-    from ..damage.heights import safe_height
+    from fruitimpact.handling.heights import safe_height
 
     kwargs = _without_velocity(args)
     if "drop_height" in kwargs:
@@ -132,7 +132,7 @@ def cmd_safe_height(args) -> int:
         key, columns, heights, rows, safe = _risk_map(kwargs, args.map)
         report["risk_map"] = {"by": key, "safe_height": safe}
         if args.map_csv:
-            from ..outputs import atomic_write
+            from fruitimpact.impact.outputs import atomic_write
 
             def write(tmp):
                 with open(tmp, "w", encoding="utf-8") as handle:
@@ -144,8 +144,8 @@ def cmd_safe_height(args) -> int:
 
             _library_call(atomic_write, args.map_csv, write, "--map-csv")
         if args.plot:
-            from ..plotting import save_figure
-            from ..plotting.damage import risk_map_figure
+            from fruitimpact.plotting import save_figure
+            from fruitimpact.plotting.damage import risk_map_figure
 
             _library_call(save_figure, risk_map_figure(key, columns, heights, rows, safe, report["criterion"]),
                           args.plot, "--plot")
@@ -174,10 +174,10 @@ def cmd_safe_height(args) -> int:
 
 # ------------------------------------------------------------------------------------------------ line
 def cmd_line(args) -> int:
-    from .. import runs
-    from ..damage.line import audit, read_line
-    from ..distributions import parse_distribution
-    from .runs import _count
+    from fruitimpact import runs
+    from fruitimpact.handling.line import audit, read_line
+    from fruitimpact.impact.distributions import parse_distribution
+    from fruitimpact.cli.runs import _count
 
     try:
         points = read_line(args.line)
@@ -187,7 +187,7 @@ def cmd_line(args) -> int:
     if criterion == "none":
         raise UsageError("argument --criterion: a line audit needs one: pressure, shear or energy (the onset "
                          "height changes by an order of magnitude between them)")
-    from ..presets import fruit_criterion
+    from fruitimpact.impact.presets import fruit_criterion
 
     # none given: the one the literature supports for the --fruit (issue 14 item 5c)
     criterion = _library_call(fruit_criterion, getattr(args, "fruit", None), criterion)
@@ -208,7 +208,7 @@ def cmd_line(args) -> int:
             distributions.append((quantity.name, parse_distribution(spec, quantity.dimension, quantity.name)))
         except ValueError as exc:
             raise UsageError(f"argument {quantity.option}: {exc}") from None
-    from .runs import _check_text
+    from fruitimpact.cli.runs import _check_text
 
     for name, value in constants.items():
         if name in REGISTRY_INPUTS:
@@ -232,8 +232,8 @@ def cmd_line(args) -> int:
     if not args.json:
         print_spreads("line", spread_lines)
     if args.plot:
-        from ..plotting import save_figure
-        from ..plotting.damage import line_figure
+        from fruitimpact.plotting import save_figure
+        from fruitimpact.plotting.damage import line_figure
 
         _library_call(save_figure, line_figure(report), args.plot, "--plot")
     if args.json:
@@ -280,13 +280,13 @@ def _library_listing(args, rows, kind: str) -> int:
 
 
 def cmd_fruits(args) -> int:
-    from ..library import fruit_rows
+    from fruitimpact.library.catalogue import fruit_rows
 
     return _library_listing(args, fruit_rows(), "fruits")
 
 
 def cmd_surfaces(args) -> int:
-    from ..library import surface_rows
+    from fruitimpact.library.catalogue import surface_rows
 
     status = _library_listing(args, surface_rows(), "surfaces")
     if not args.json:
@@ -295,7 +295,7 @@ def cmd_surfaces(args) -> int:
 
 
 def add_parsers(sub) -> None:
-    from ..quantities import INPUTS as TABLE
+    from fruitimpact.impact.quantities import INPUTS as TABLE
 
     dr = sub.add_parser("drop", help="drop a fruit from a height: the rebounds until it rests, damage per impact",
                         description="Drop a fruit from --drop-height onto a surface; every impact at its own "

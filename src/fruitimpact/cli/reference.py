@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from .common import UsageError, _float_list, _library_call, dump_json
+from fruitimpact.cli.common import UsageError, _float_list, _library_call, dump_json
 
 
 def _checked(check, *args):
@@ -16,14 +16,14 @@ def _checked(check, *args):
 
 
 def cmd_paper(args) -> int:
-    from ..outputs import check_output_folder
-    from ..paper import format_paper_report, paper_report
+    from fruitimpact.impact.outputs import check_output_folder
+    from fruitimpact.reference.paper import format_paper_report, paper_report
 
     if args.figures:
         _checked(check_output_folder, args.figures, "--figures")
     report = paper_report()
     if args.figures:
-        from ..paper import write_paper_figures
+        from fruitimpact.reference.paper import write_paper_figures
 
         report["figures"] = _library_call(write_paper_figures, args.figures)
     if args.json:
@@ -35,16 +35,16 @@ def cmd_paper(args) -> int:
 
 
 def cmd_models(args) -> int:
-    from ..comparison import format_restitution_table, restitution_table
-    from ..plotting import restitution_figure
-    from ..models import DAMPING_LAWS
+    from fruitimpact.reference.comparison import format_restitution_table, restitution_table
+    from fruitimpact.plotting import restitution_figure
+    from fruitimpact.physics import DAMPING_LAWS
 
     for name in args.model or ():
         if name not in DAMPING_LAWS:
             raise UsageError(f"argument --model: model must be one of {', '.join(DAMPING_LAWS)}; got {name!r}")
     targets = _float_list("--targets", args.targets, 0.0, 1.0, True)
     velocities = _float_list("--velocities", args.velocities, 0.0, math.inf, False)
-    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, atomic_write, check_output
+    from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS, atomic_write, check_output
 
     if args.csv:
         _checked(check_output, args.csv, "--csv", CSV_FORMAT)
@@ -54,7 +54,7 @@ def cmd_models(args) -> int:
     if args.csv:
         _library_call(atomic_write, args.csv, lambda tmp: table.to_csv(tmp, index=False), "--csv")
     if args.plot:
-        from ..plotting import save_figure
+        from fruitimpact.plotting import save_figure
 
         _library_call(save_figure, restitution_figure(table), args.plot, "--plot")
     if args.json:

@@ -14,7 +14,7 @@ import math
 import sys
 from pathlib import Path
 
-from .common import PROG, UsageError, _with_option, add_spread_option, dump_json, lot_distributions, print_spreads
+from fruitimpact.cli.common import PROG, UsageError, _with_option, add_spread_option, dump_json, lot_distributions, print_spreads
 
 #: Inputs whose range depends on other inputs: not checked alone when constant.
 _DEPENDENT_INPUTS = ("alpha", "step")
@@ -46,13 +46,13 @@ def _count(option: str, text: str, low: int, high: int | None = None) -> int:
 
 def _run_inputs():
     """(option, name, quantity) of every input of the table of quantities, numeric first."""
-    from ..quantities import INPUTS
+    from fruitimpact.impact.quantities import INPUTS
 
     return [(quantity.option or "--" + name.replace("_", "-"), name, quantity) for name, quantity in INPUTS.items()]
 
 
 def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> None:
-    from ..runs import CHUNK_ROWS, ENGINES, MAX_CHUNK_ROWS
+    from fruitimpact.runs import CHUNK_ROWS, ENGINES, MAX_CHUNK_ROWS
 
     group = parser.add_argument_group("run (chunks, resume, engines)")
     group.add_argument("-o", "--output", metavar="OUT", required=output_required,
@@ -75,7 +75,7 @@ def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> 
 
 def _check_output(option: str, path, formats) -> None:
     """``outputs.check_output`` as a one-line UsageError (an OSError of the file system too)."""
-    from ..outputs import check_output
+    from fruitimpact.impact.outputs import check_output
 
     try:
         check_output(path, option, formats)
@@ -87,7 +87,7 @@ def _check_output(option: str, path, formats) -> None:
 
 def _check_figure(option: str, path) -> None:
     """A figure path is writable and matplotlib is there, before any work."""
-    from ..outputs import FIGURE_FORMATS
+    from fruitimpact.impact.outputs import FIGURE_FORMATS
 
     if path is None:
         return
@@ -99,8 +99,8 @@ def _check_figure(option: str, path) -> None:
 def _check_run_options(args, plan):
     """The output, the work folder and the engine of ``args``, checked before any work; returns
     (engine, work folder)."""
-    from .. import runs
-    from ..outputs import TABLE_FORMATS, check_folder
+    from fruitimpact import runs
+    from fruitimpact.impact.outputs import TABLE_FORMATS, check_folder
 
     if args.output is not None:
         _check_output("-o/--output", args.output, TABLE_FORMATS)
@@ -129,7 +129,7 @@ def _check_run_options(args, plan):
 
 def _run(args, plan, keep_columns=(), percentiles=None):
     """Execute ``plan`` with the run options of ``args``; one-line errors, resumable interruption."""
-    from .. import runs
+    from fruitimpact import runs
 
     engine, workdir = _check_run_options(args, plan)
     try:
@@ -156,8 +156,8 @@ def _status_line(summary) -> str:
 def _check_constants(constants: dict, text: dict, given=()) -> None:
     """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
     energy criterion's threshold), before any chunk runs (one row through batch.evaluate)."""
-    from ..batch import evaluate
-    from ..quantities import INPUTS
+    from fruitimpact.impact.evaluation import evaluate
+    from fruitimpact.impact.quantities import INPUTS
 
     if not constants and not text:
         return
@@ -173,8 +173,8 @@ def _check_constants(constants: dict, text: dict, given=()) -> None:
 
 
 def _check_text(name: str, values) -> None:
-    from ..quantities import option_of
-    from ..registries import REGISTRIES
+    from fruitimpact.impact.quantities import option_of
+    from fruitimpact.impact.registries import REGISTRIES
 
     registry = REGISTRIES[name]
     for value in values:
@@ -184,7 +184,7 @@ def _check_text(name: str, values) -> None:
 
 
 def _check_conflicts(given) -> None:
-    from ..quantities import ALTERNATIVES
+    from fruitimpact.impact.quantities import ALTERNATIVES
 
     for group in ALTERNATIVES:
         named = [name for name in group if name in given]
@@ -194,7 +194,7 @@ def _check_conflicts(given) -> None:
 
 
 def cmd_batch(args) -> int:
-    from ..runs import MAX_CHUNK_ROWS, Plan, TableSource
+    from fruitimpact.runs import MAX_CHUNK_ROWS, Plan, TableSource
 
     try:
         source = TableSource.open(args.input)
@@ -211,7 +211,7 @@ def cmd_batch(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from .. import runs
+    from fruitimpact import runs
 
     axes, constants, text = [], {}, {}
     order = list(getattr(args, "order", None) or [])
@@ -260,7 +260,7 @@ def cmd_sweep(args) -> int:
 
 
 def _save(option: str, fig, path) -> None:
-    from ..plotting import save_figure
+    from fruitimpact.plotting import save_figure
 
     try:
         save_figure(fig, path, option)
@@ -269,7 +269,7 @@ def _save(option: str, fig, path) -> None:
 
 
 def _format_population(summary, names) -> str:
-    from ..runs import CHARACTERISTICS
+    from fruitimpact.runs import CHARACTERISTICS
 
     method = summary.percentiles
     lines = [f"population: {_status_line(summary)}",
@@ -290,8 +290,8 @@ def _format_population(summary, names) -> str:
 
 
 def cmd_population(args) -> int:
-    from .. import runs
-    from ..distributions import Constant, parse_distribution
+    from fruitimpact import runs
+    from fruitimpact.impact.distributions import Constant, parse_distribution
 
     rows = _count("-n/--rows", args.rows, 1, runs.MAX_ROWS)
     seed = _count("--seed", args.seed, 0)
@@ -363,7 +363,7 @@ def _input_help(quantity) -> str:
 
 def add_parsers(sub) -> None:
     """The parsers of ``batch``, ``sweep`` and ``population``."""
-    from ..runs import MAX_AXIS_VALUES, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS
+    from fruitimpact.runs import MAX_AXIS_VALUES, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS
 
     bat = sub.add_parser("batch", help="characteristics of every row of a CSV/Parquet file of inputs",
                          description="Rows of inputs (columns named like simulate's options: mass, diameter, "

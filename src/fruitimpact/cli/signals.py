@@ -7,8 +7,8 @@ import json
 import math
 import sys
 
-from .common import PROG, UsageError, _library_call, dump_json
-from ..units import parse_quantity
+from fruitimpact.cli.common import PROG, UsageError, _library_call, dump_json
+from fruitimpact.impact.units import parse_quantity
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
@@ -73,10 +73,10 @@ def _setting_error(exc: ValueError) -> UsageError:
 def analysis_from(args, rate: float, rate_known: bool = True):
     """(DetectorSettings, Analysis) from the options, every value checked before any work (those that depend
     on the sample rate only when ``rate_known``)."""
-    from ..constants import STANDARD_GRAVITY
-    from ..signals.analysis import Analysis
-    from ..signals.detect import Detector, DetectorSettings
-    from ..signals.sort import FirmnessClasses
+    from fruitimpact.physics.constants import STANDARD_GRAVITY
+    from fruitimpact.signals.analysis import Analysis
+    from fruitimpact.signals.detect import Detector, DetectorSettings
+    from fruitimpact.signals.sort import FirmnessClasses
 
     hum = _float("--hum", args.hum, "frequency")
     lowpass = _float("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
@@ -189,16 +189,16 @@ class _Progress:
 
 
 def cmd_analyze(args) -> int:
-    from ..signals.analysis import public
-    from ..signals.read import open_recording
-    from ..signals.stream import StreamAnalyzer
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.read import open_recording
+    from fruitimpact.signals.stream import StreamAnalyzer
 
     rate = _float("--rate", args.rate, "frequency")
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
     if lanes is None:
         raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
     if args.plot:
-        from ..outputs import FIGURE_FORMATS, check_output
+        from fruitimpact.impact.outputs import FIGURE_FORMATS, check_output
 
         try:
             check_output(args.plot, "--plot", FIGURE_FORMATS)
@@ -251,9 +251,9 @@ def cmd_analyze(args) -> int:
     if not args.json:
         print(f"{analyzer.impacts} impacts in {done / source.rate:.4g} s")
     if args.plot:
-        from ..plotting import save_figure
-        from ..plotting.signals import analysis_figure
-        from ..signals.read import read_recording
+        from fruitimpact.plotting import save_figure
+        from fruitimpact.plotting.signals import analysis_figure
+        from fruitimpact.signals.read import read_recording
 
         recording = read_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
         _library_call(save_figure, analysis_figure(recording, impacts, reports, analysis), args.plot, "--plot")
@@ -297,7 +297,7 @@ def _reading_error(exc: ValueError, args) -> str:
 def cmd_classes(args) -> int:
     import csv
 
-    from ..signals.sort import SORT_INDICES, calibrate, confusion
+    from fruitimpact.signals.sort import SORT_INDICES, calibrate, confusion
 
     if args.by not in SORT_INDICES:
         raise UsageError(f"argument --by: must be one of {', '.join(SORT_INDICES)}; got {args.by!r}")
@@ -381,9 +381,9 @@ def _classes_option(text: str):
 
 
 def cmd_synth(args) -> int:
-    from ..outputs import check_output
-    from ..signals import read as reading
-    from ..signals.synth import Population, SensorModel, synthesize, truth_path, write_recording, write_truth
+    from fruitimpact.impact.outputs import check_output
+    from fruitimpact.signals import read as reading
+    from fruitimpact.signals.synth import Population, SensorModel, synthesize, truth_path, write_recording, write_truth
 
     try:
         fmt = reading.recording_format(args.output, args.format, "--format")
@@ -490,8 +490,8 @@ def add_synth_parser(sub) -> None:
 
 # -------------------------------------------------------------------------------------------- stream
 def cmd_stream(args) -> int:
-    from ..signals.analysis import public
-    from ..signals.stream import StreamAnalyzer, iter_chunks, serve
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve
 
     rate = _float("--rate", args.rate, "frequency")
     if rate is None:

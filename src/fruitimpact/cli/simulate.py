@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 import sys
 
-from ..quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS, OUTPUTS
-from .common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
+from fruitimpact.impact.quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS, OUTPUTS
+from fruitimpact.cli.common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
 
 
 def _law_line(law) -> str:
@@ -68,8 +68,8 @@ def format_result_table(result) -> str:
 
 def _overlays(args) -> list[dict]:
     """--overlay MODEL[:CALIBRATION[:METHOD]] → simulate() overrides, checked against the registries."""
-    from ..models import CALIBRATIONS, DAMPING_LAWS
-    from ..solvers import SOLVERS
+    from fruitimpact.physics import CALIBRATIONS, DAMPING_LAWS
+    from fruitimpact.impact.solvers import SOLVERS
 
     overlays = []
     for text in args.overlay or ():
@@ -86,7 +86,7 @@ def _overlays(args) -> list[dict]:
 
 def _check_outputs(args) -> None:
     """Every output path and format, before the impact is computed."""
-    from ..outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
+    from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
 
     for option, path, formats in (("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS)):
         if path is not None:
@@ -97,7 +97,7 @@ def _check_outputs(args) -> None:
 
 
 def cmd_simulate(args) -> int:
-    from ..impact import simulate
+    from fruitimpact.impact.simulation import simulate
 
     kwargs = _simulate_kwargs(args)
     overlays = _overlays(args)
@@ -108,7 +108,7 @@ def cmd_simulate(args) -> int:
     if args.csv and result.status != "failed":
         _library_call(result.curves.to_csv, args.csv, argument="--csv")
     if args.plot and result.status != "failed":
-        from ..plotting import impact_figure, save_figure
+        from fruitimpact.plotting import impact_figure, save_figure
 
         results = [result] + [_library_call(simulate, **{**kwargs, **overlay}) for overlay in overlays]
         _library_call(save_figure, impact_figure(results, title="fruitimpact: impact of the fruit on the surface"),

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import bruise
+from fruitimpact.damage import bruise
 
 #: Criterion codes of the ``criterion`` text input (``none`` first).
 CRITERION_NAMES = ("none", "pressure", "shear", "energy")

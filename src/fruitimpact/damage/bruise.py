@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
+from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 #: Stropek & Gołacki (2020), pear, three highest impact speeds: contact width ≈ 1.4 × bruise width.
 CONTACT_TO_BRUISE_WIDTH = 1.4
@@ -482,7 +482,7 @@ def onset_drop_height_rigid(failure_stress_equivalent_pressure, density, contact
     contact_modulus : float or array
         Contact modulus E* [Pa], > 0 (E/(1 − ν²) on a rigid surface).
     g : float or array
-        Gravitational acceleration [m/s²], > 0 (default: standard gravity 9.80665, ``fruitimpact.constants``).
+        Gravitational acceleration [m/s²], > 0 (default: standard gravity 9.80665, ``fruitimpact.physics.constants``).
     """
     p = _values("failure_stress_equivalent_pressure", failure_stress_equivalent_pressure, 0.0, unit="Pa")
     rho = _values("density", density, 0.0, low_open=True, unit="kg/m³")

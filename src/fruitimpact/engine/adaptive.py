@@ -78,10 +78,10 @@ import math
 import numba as nb
 import numpy as np
 
-from .codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, KELVIN_VOIGT, KUWABARA_KONO, MAX_PRESSURE,
+from fruitimpact.engine.codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, KELVIN_VOIGT, KUWABARA_KONO, MAX_PRESSURE,
                     N_CHARACTERISTICS, POWER_LAW, TIME_TO_PEAK)
-from .forces import contact_force, pressure_ratio
-from .powerlaw import PARALLEL_MIN_ROWS, fill_characteristics
+from fruitimpact.engine.forces import contact_force, pressure_ratio
+from fruitimpact.engine.powerlaw import PARALLEL_MIN_ROWS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
 

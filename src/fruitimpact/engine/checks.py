@@ -4,7 +4,7 @@
 column order) into one of the outcomes below and removes a round-off excess
 of the restitution over 1 in place (within ``tolerance``: e = 1, exit
 velocity = impact velocity, absorbed energy 0), so that round-off never
-creates energy in reported figures.  ``fruitimpact.status`` turns the
+creates energy in reported figures.  ``fruitimpact.impact.status`` turns the
 outcomes into statuses and messages.  Row-major, one pass: a million rows
 cost a few milliseconds.
 """
@@ -16,7 +16,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .codes import ABSORBED_ENERGY, CONTACT_DURATION, EXIT_VELOCITY, MAX_DEFLECTION, PEAK_FORCE, RESTITUTION
+from fruitimpact.engine.codes import ABSORBED_ENERGY, CONTACT_DURATION, EXIT_VELOCITY, MAX_DEFLECTION, PEAK_FORCE, RESTITUTION
 
 #: Outcomes of ``classify``.
 PHYSICAL = 0

@@ -2,7 +2,7 @@
 
 Each family is an integer code with a fixed parameter vector, so that one
 compiled integrator serves them all.  The friendly registry of named models
-(``fruitimpact.models``) maps each published model onto one of these.
+(``fruitimpact.physics``) maps each published model onto one of these.
 All forces are in N, δ in m (positive in compression), δ̇ in m/s (positive
 while approaching).
 """
@@ -13,7 +13,7 @@ import math
 
 import numba as nb
 
-from .codes import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, TSUJI  # noqa: F401  (the family codes)
+from fruitimpact.engine.codes import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, TSUJI  # noqa: F401  (the family codes)
 
 _JIT = dict(cache=True, error_model="numpy")
 

@@ -58,9 +58,9 @@ import math
 import numba as nb
 import numpy as np
 
-from .codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
-from .powerlaw import r_func
-from .quadrature import gauss_jacobi
+from fruitimpact.engine.codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
+from fruitimpact.engine.powerlaw import r_func
+from fruitimpact.engine.quadrature import gauss_jacobi
 
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 

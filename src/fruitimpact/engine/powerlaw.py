@@ -34,13 +34,13 @@ import math
 import numba as nb
 import numpy as np
 
-from .quadrature import gauss_jacobi
+from fruitimpact.engine.quadrature import gauss_jacobi
 
 #: Gauss–Jacobi nodes per integral; the integrands' remaining factors are
 #: analytic; 16 nodes already reach 1e-13 relative for e ≥ 0.05, 20 leave a margin (tests).
 QUADRATURE_NODES = 20
 
-from .codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_DURATION, CONTACT_RADIUS,  # noqa: F401
+from fruitimpact.engine.codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_DURATION, CONTACT_RADIUS,  # noqa: F401
                     EXIT_VELOCITY, FIRMNESS_C, FIRMNESS_C_STAR, MAX_DEFLECTION, MAX_PRESSURE, N_CHARACTERISTICS,
                     PEAK_FORCE, RESTITUTION, TIME_TO_MAX_DEFLECTION, TIME_TO_PEAK)
 

@@ -18,8 +18,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .forces import contact_force, pressure_ratio
-from .powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
+from fruitimpact.engine.forces import contact_force, pressure_ratio
+from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
 
 _JIT = dict(cache=True, error_model="numpy")
 

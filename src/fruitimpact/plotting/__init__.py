@@ -7,11 +7,11 @@
 * ``save_figure``: writes any of them atomically, the format chosen by the extension.
 """
 
-from ._backend import save_figure
-from .damage import line_figure, risk_map_figure
-from .impact import impact_figure
-from .models import restitution_figure
-from .runs import histogram_figure, sweep_figure
+from fruitimpact.plotting._backend import save_figure
+from fruitimpact.plotting.damage import line_figure, risk_map_figure
+from fruitimpact.plotting.impact import impact_figure
+from fruitimpact.plotting.models import restitution_figure
+from fruitimpact.plotting.runs import histogram_figure, sweep_figure
 
 __all__ = ["histogram_figure", "impact_figure", "line_figure", "restitution_figure", "risk_map_figure", "save_figure",
            "sweep_figure"]

@@ -6,7 +6,7 @@ use, and nowhere else in fruitimpact.
 
 from __future__ import annotations
 
-from ..outputs import FIGURE_FORMATS, atomic_write, output_format
+from fruitimpact.impact.outputs import FIGURE_FORMATS, atomic_write, output_format
 
 
 def _pyplot():

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ._backend import _pyplot
+from fruitimpact.plotting._backend import _pyplot
 
 
 def risk_map_figure(key: str, columns, heights, rows, safe: dict, criterion: str):

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from ._backend import _pyplot
+from fruitimpact.plotting._backend import _pyplot
 
 
 def _label(result) -> str:

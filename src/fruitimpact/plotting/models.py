@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import _pyplot
+from fruitimpact.plotting._backend import _pyplot
 
 
 def restitution_figure(table, velocity=None):
@@ -19,7 +19,7 @@ def restitution_figure(table, velocity=None):
 
     Returns the matplotlib Figure; save it with ``save_figure``.
     """
-    from ..models import DAMPING_LAWS
+    from fruitimpact.physics import DAMPING_LAWS
 
     plt = _pyplot()
     velocities = sorted(table["velocity"].unique())

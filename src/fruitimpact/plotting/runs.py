@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..quantities import CHARACTERISTICS, INPUTS
-from ._backend import _pyplot
+from fruitimpact.impact.quantities import CHARACTERISTICS, INPUTS
+from fruitimpact.plotting._backend import _pyplot
 
 #: A second swept input with more values than this is drawn as a heat map, not as lines.
 MAX_LINES = 8

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import _pyplot
+from fruitimpact.plotting._backend import _pyplot
 
 #: Impacts drawn in detail (data and fit).
 DETAIL = 4
@@ -31,7 +31,7 @@ def analysis_figure(recording, impacts, reports, analysis):
     if len(recording.lanes) > 1:
         top.legend(fontsize=8)
     if detail:
-        from ..signals.fit import model_curve
+        from fruitimpact.signals.fit import model_curve
 
         for k in range(detail):
             impact, report = impacts[k], reports[k]

@@ -2,7 +2,7 @@
 
 A run is a ``Plan``: a *source* of input rows (a table file, a grid, a
 population of distributions), cut into chunks of ``chunk_rows`` rows.  Each
-chunk is evaluated by ``fruitimpact.batch.evaluate``; its rows are written as
+chunk is evaluated by ``fruitimpact.impact.evaluation.evaluate``; its rows are written as
 a part file in a work folder (and, in this process, straight into the output),
 with a summary file for populations, and recorded with their SHA-256 in the
 folder's manifest.  A different job is refused instead of mixed in; an
@@ -27,16 +27,16 @@ Population members are drawn from generators derived from
 number: the same for any chunk size, engine, or interruption.
 """
 
-from ..plotting.runs import histogram_figure, sweep_figure
-from ..quantities import CHARACTERISTICS, DEFAULT_SUMMARY, INPUTS, Quantity
-from .chunks import evaluate_rows, run_chunk
-from .engines import ENGINES, DaskEngine, InProcessEngine
-from . import execute as execute_module  # noqa: F401  (the module, for tests that patch it)
-from .execute import default_workdir, execute, merge_parts, read_column
-from .plan import (BLOCK_ROWS, CHUNK_ROWS, MAX_AXIS_VALUES, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES,
+from fruitimpact.plotting.runs import histogram_figure, sweep_figure
+from fruitimpact.impact.quantities import CHARACTERISTICS, DEFAULT_SUMMARY, INPUTS, Quantity
+from fruitimpact.runs.chunks import evaluate_rows, run_chunk
+from fruitimpact.runs.engines import ENGINES, DaskEngine, InProcessEngine
+from fruitimpact.runs import execute as execute_module  # noqa: F401  (the module, for tests that patch it)
+from fruitimpact.runs.execute import default_workdir, execute, merge_parts, read_column
+from fruitimpact.runs.plan import (BLOCK_ROWS, CHUNK_ROWS, MAX_AXIS_VALUES, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES,
                    SAMPLE_ROWS, Plan, RunError, Threshold, characteristic, characteristics_list)
-from .sources import Axis, GridSource, PopulationSource, TableSource, parse_axis, table_format
-from .summaries import RunSummary
+from fruitimpact.runs.sources import Axis, GridSource, PopulationSource, TableSource, parse_axis, table_format
+from fruitimpact.runs.summaries import RunSummary
 
 __all__ = ["BLOCK_ROWS", "CHARACTERISTICS", "CHUNK_ROWS", "DEFAULT_SUMMARY", "ENGINES", "INPUTS", "MAX_AXIS_VALUES",
            "MAX_CHUNK_ROWS", "MAX_ROWS", "MAX_SAMPLE_ROWS", "PERCENTILES", "SAMPLE_ROWS", "Axis", "DaskEngine",

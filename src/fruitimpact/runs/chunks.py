@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .workdir import write_part, write_summary
+from fruitimpact.runs.workdir import write_part, write_summary
 
 
 def evaluate_rows(inputs, start: int, errors=None):
@@ -21,7 +21,7 @@ def evaluate_rows(inputs, start: int, errors=None):
     ``errors``: None, or a message per row that makes the row invalid unread (ragged CSV rows).
     Power-law rows always use the engine's table, so results do not depend on where
     the chunk boundaries fall; ``start`` numbers the rows (``Evaluation.table(start)``)."""
-    from ..batch import evaluation
+    from fruitimpact.impact.evaluation import evaluation
 
     return evaluation(inputs, tabulated=True, errors=errors)
 
@@ -33,8 +33,8 @@ def summarise(plan, result, start: int) -> dict | None:
     probability)."""
     if not plan.stats:
         return None
-    from ..engine.codes import COLUMN
-    from ..engine.moments import block_summary
+    from fruitimpact.engine.codes import COLUMN
+    from fruitimpact.engine.moments import block_summary
 
     ok = result.status == 0
     probability = plan.sample_probability
@@ -45,7 +45,7 @@ def summarise(plan, result, start: int) -> dict | None:
             result.block, [COLUMN[name] for name in plan.stats], ok, chosen,
             [(COLUMN[t.name], t.op, t.value) for t in plan.thresholds])
         return {"moments": moments, "thresholds": counts, "sample": sample}
-    from ..engine.moments import column_moments
+    from fruitimpact.engine.moments import column_moments
 
     data = {name: np.asarray(result.columns[name], dtype=float) for name in set(names)}
     moments = [column_moments(data[name], ok) for name in plan.stats]

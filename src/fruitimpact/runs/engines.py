@@ -11,8 +11,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from . import chunks
-from .plan import RunError
+from fruitimpact.runs import chunks
+from fruitimpact.runs.plan import RunError
 
 #: A Dask scheduler address: ``tcp://host:port``, ``host:port`` (no spaces).
 _ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+.-]*://)?[^\s/:]+(?::\d{1,5})?(?:/\S*)?$")

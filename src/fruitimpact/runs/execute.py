@@ -14,13 +14,13 @@ import sys
 import time
 from pathlib import Path
 
-from ..outputs import TABLE_FORMATS, atomic_write, check_output, remove_stale_temporaries
-from .engines import InProcessEngine
-from .locking import RunLock
-from .plan import PERCENTILES, RunError
-from .sources import table_format
-from .summaries import RunSummary, add_statuses, combine
-from .workdir import WorkDir, read_part, read_summary
+from fruitimpact.impact.outputs import TABLE_FORMATS, atomic_write, check_output, remove_stale_temporaries
+from fruitimpact.runs.engines import InProcessEngine
+from fruitimpact.runs.locking import RunLock
+from fruitimpact.runs.plan import PERCENTILES, RunError
+from fruitimpact.runs.sources import table_format
+from fruitimpact.runs.summaries import RunSummary, add_statuses, combine
+from fruitimpact.runs.workdir import WorkDir, read_part, read_summary
 
 #: Runs expected to take longer than this [s] announce an estimate on stderr.
 ESTIMATE_AFTER = 60.0

@@ -12,7 +12,7 @@ import fcntl
 import os
 from pathlib import Path
 
-from .plan import RunError
+from fruitimpact.runs.plan import RunError
 
 
 class RunLock:

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..quantities import CHARACTERISTICS, Quantity
+from fruitimpact.impact.quantities import CHARACTERISTICS, Quantity
 
 #: Rows per chunk by default: large enough that the per-chunk overhead is small next to evaluation.
 CHUNK_ROWS = 500_000
@@ -129,7 +129,7 @@ class Plan:
         return 1.0 if self.rows is None or self.rows <= self.sample_rows else self.sample_rows / self.rows
 
     def identity(self) -> dict:
-        from .. import __version__
+        from fruitimpact import __version__
 
         return {"kind": self.kind, "format": WORK_FORMAT, "fruitimpact": __version__,
                 "source": self.source.identity(), "chunk_rows": self.chunk_rows, "write_rows": self.write_rows,

@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..outputs import TABLE_FORMATS
-from ..labels import Labels
-from ..quantities import INPUTS
-from ..units import parse_quantity
-from .plan import BLOCK_ROWS, MAX_AXIS_VALUES, check_count
+from fruitimpact.impact.outputs import TABLE_FORMATS
+from fruitimpact.impact.labels import Labels
+from fruitimpact.impact.quantities import INPUTS
+from fruitimpact.impact.units import parse_quantity
+from fruitimpact.runs.plan import BLOCK_ROWS, MAX_AXIS_VALUES, check_count
 
 #: Bytes of a CSV file parsed at a time.
 CSV_BLOCK_BYTES = 8 << 20
@@ -100,7 +100,7 @@ def numeric_fast_path(column):
 def _with_keys(table):
     """``table`` with its columns named by input (``drop-height`` → ``drop_height``) and plain
     numeric columns as float64."""
-    from ..inputs import column_key
+    from fruitimpact.impact.inputs import column_key
 
     import pyarrow as pa
 
@@ -136,7 +136,7 @@ class TableSource:
     @classmethod
     def open(cls, path) -> "TableSource":
         """Check the file and its columns (unknown ones refused) before any work; ``ValueError``."""
-        from ..inputs import check_columns
+        from fruitimpact.impact.inputs import check_columns
 
         fmt = table_format(path, "input")
         if not Path(path).is_file():
@@ -426,7 +426,7 @@ class PopulationSource:
 
     def inputs(self, start: int, stop: int, payload) -> tuple:
         """(columns, None): the members start..stop-1."""
-        from ..distributions import Constant
+        from fruitimpact.impact.distributions import Constant
 
         columns = {}
         for name, dist in self.distributions:

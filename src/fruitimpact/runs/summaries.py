@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..quantities import CHARACTERISTICS
+from fruitimpact.impact.quantities import CHARACTERISTICS
 
 
 @dataclass

@@ -33,9 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..outputs import temporary_path
-from .locking import RunLock
-from .plan import WORK_FORMAT, RunError
+from fruitimpact.impact.outputs import temporary_path
+from fruitimpact.runs.locking import RunLock
+from fruitimpact.runs.plan import WORK_FORMAT, RunError
 
 MARKER = ".fruitimpact-workdir"
 MANIFEST = "manifest.jsonl"

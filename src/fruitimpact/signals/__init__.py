@@ -11,9 +11,9 @@ SI units throughout.  Importing this package loads neither the engine nor SciPy,
 or nptdms: each is imported by the function that needs it.
 """
 
-from .read import open_recording, read_recording
-from .recording import Recording
-from .synth import (
+from fruitimpact.signals.read import open_recording, read_recording
+from fruitimpact.signals.recording import Recording
+from fruitimpact.signals.synth import (
     Impact,
     Population,
     SensorModel,

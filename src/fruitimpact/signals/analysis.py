@@ -37,12 +37,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
-from .detect import DetectedImpact
-from .indices import impact_indices, second_pulse
-from .rebounds import PulseSummary, from_indices, judge, refine, shape_table
-from .sort import FirmnessClasses
-from .split import MISFIT_LIMIT, split_contact
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+from fruitimpact.signals.detect import DetectedImpact
+from fruitimpact.signals.indices import impact_indices, second_pulse
+from fruitimpact.signals.rebounds import PulseSummary, from_indices, judge, refine, shape_table
+from fruitimpact.signals.sort import FirmnessClasses
+from fruitimpact.signals.split import MISFIT_LIMIT, split_contact
 
 #: Keys of a fit that join the report (a contract: analyze --fit).
 FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
@@ -294,8 +294,8 @@ def _warm_up(analysis: Analysis) -> None:
     costs what the others cost (without it the first report took 46–71 ms, benchmarks/latency.py)."""
     if analysis.rate in _WARM:
         return
-    from ..engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
-    from .fit import at_velocity, prepare
+    from fruitimpact.engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
+    from fruitimpact.signals.fit import at_velocity, prepare
 
     prepare()
     shape_table()
@@ -384,7 +384,7 @@ def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
     """The simulator's pulse fitted to the contact's own samples: with the given mass, or at a unit
     velocity (the shape, indices and relative errors do not depend on it; ``_restated`` splits the
     Hertz scales for the contact's real speed)."""
-    from .fit import fit_impact
+    from fruitimpact.signals.fit import fit_impact
 
     time = (impact.window_start + np.arange(impact.window.size)) / analysis.rate
     try:
@@ -397,7 +397,7 @@ def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
 
 def _restated(shape: dict, analysis: Analysis, velocity) -> dict:
     """The shape fit for this contact's knowns: the given mass as it is, else its impact speed."""
-    from .fit import at_velocity
+    from fruitimpact.signals.fit import at_velocity
 
     if analysis.mass is not None or not shape.get("converged"):
         return shape

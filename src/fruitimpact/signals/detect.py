@@ -76,8 +76,8 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from .filters import butterworth_sos, solve_small
-from .settings import DetectorSettings
+from fruitimpact.signals.filters import butterworth_sos, solve_small
+from fruitimpact.signals.settings import DetectorSettings
 
 __all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
 

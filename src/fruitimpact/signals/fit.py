@@ -58,8 +58,8 @@ import math
 import numba as nb
 import numpy as np
 
-from ..engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
-from ..engine.powerlaw import (
+from fruitimpact.engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
+from fruitimpact.engine.powerlaw import (
     powerlaw_characteristics,
     powerlaw_curves,
     powerlaw_curves_batch,

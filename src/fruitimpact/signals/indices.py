@@ -47,8 +47,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .detect import DetectedImpact
-from .filters import solve_small
+from fruitimpact.signals.detect import DetectedImpact
+from fruitimpact.signals.filters import solve_small
 
 __all__ = ["FALL_HIGH", "FALL_LOW", "INDEX_KEYS", "RISE_CURVATURE", "RISE_HIGH", "RISE_LOW", "impact_indices",
            "second_pulse"]

@@ -55,7 +55,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
+from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "refine", "shape_table"]
 
@@ -75,8 +75,8 @@ def shape_table() -> dict:
     """The dimensionless characteristics of the force law against x = c V (built once, from the exact
     engine's batch path): ``x``, ``e``, ``P`` (peak), ``tc``, ``T`` and ``h`` = (1 + e)/(P τ_c)."""
     if not _TABLE:
-        from ..engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
-        from ..engine.powerlaw import powerlaw_characteristics
+        from fruitimpact.engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
+        from fruitimpact.engine.powerlaw import powerlaw_characteristics
 
         x = np.expm1(np.linspace(0.0, math.log1p(_X_MAX), 801))
         one = np.ones_like(x)

@@ -15,7 +15,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ..validation import InputError
+from fruitimpact.impact.validation import InputError
 
 
 def _finite_number(name: str, value, *, positive: bool = False) -> float:

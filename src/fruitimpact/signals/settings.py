@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..validation import check_number
+from fruitimpact.impact.validation import check_number
 
 __all__ = ["DetectorSettings"]
 

@@ -21,8 +21,8 @@ import math
 
 import numpy as np
 
-from .fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, levenberg_marquardt, named_result
-from .indices import SECOND_PULSE_SMOOTHING, departure_from_one_peak
+from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, levenberg_marquardt, named_result
+from fruitimpact.signals.indices import SECOND_PULSE_SMOOTHING, departure_from_one_peak
 
 __all__ = ["MISFIT_LIMIT", "split_contact"]
 

@@ -33,8 +33,8 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from .analysis import Analysis
-from .detect import DetectedImpact, Detector, DetectorSettings
+from fruitimpact.signals.analysis import Analysis
+from fruitimpact.signals.detect import DetectedImpact, Detector, DetectorSettings
 
 __all__ = ["Float32Source", "StreamAnalyzer", "TextSource", "iter_chunks", "serve"]
 

@@ -43,10 +43,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
-from ..validation import InputError, check_integer, check_number
-from .read import _column, recording_format
-from .recording import Recording
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+from fruitimpact.impact.validation import InputError, check_integer, check_number
+from fruitimpact.signals.read import _column, recording_format
+from fruitimpact.signals.recording import Recording
 
 #: Number of output samples simulated at once on the analogue grid (bounds the memory of long recordings).
 _CHUNK = 1 << 16
@@ -380,7 +380,7 @@ class _Contact:
 def _evaluate(rows: list[dict], names: list[str]) -> list[dict]:
     """Characteristics of every row (Hunt–Crossley, exact calibration, accurate solver);
     a row that is not ok is refused naming it."""
-    from ..batch import evaluate
+    from fruitimpact.impact.evaluation import evaluate
 
     keys = ("mass", "diameter", "modulus", "poisson", "velocity", "drop_height", "restitution", "alpha")
     table = {key: [row.get(key) for row in rows] for key in keys}
@@ -529,7 +529,7 @@ def _root(contacts, k):
 
 def _curve(row: dict, times: np.ndarray) -> np.ndarray:
     """The exact contact force [N] of one impact at ``times`` [s] after its first touch."""
-    from ..engine.powerlaw import powerlaw_curves
+    from fruitimpact.engine.powerlaw import powerlaw_curves
 
     return powerlaw_curves(row["mass"], row["law_stiffness"], row["damping_factor"], row["velocity"], times)[2]
 
@@ -541,7 +541,7 @@ def _splines(contacts) -> list:
     is ~1e-6 of the peak force (below 1e-4 N for an apple of 90 N)."""
     from scipy.interpolate import CubicHermiteSpline
 
-    from ..engine.powerlaw import powerlaw_curves_batch
+    from fruitimpact.engine.powerlaw import powerlaw_curves_batch
 
     rows = [c.row for c in contacts]
     mass, stiffness, damping, velocity, duration = (np.array([r[key] for r in rows]) for key in
@@ -667,7 +667,7 @@ def write_recording(recording: Recording, path, format: str | None = None) -> Pa
     path that cannot be written, a lane name CSV cannot carry, or forces
     beyond float32 for ``f32``.
     """
-    from ..outputs import atomic_write, check_output
+    from fruitimpact.impact.outputs import atomic_write, check_output
 
     if not isinstance(recording, Recording):
         raise InputError(f"recording must be a Recording; got {type(recording).__name__}", "recording")
@@ -741,7 +741,7 @@ def write_truth(truth: dict, path) -> Path:
     """Write ``truth`` as JSON (atomically) to ``truth_path(path)``: give the recording's path
     (``run.csv`` → ``run.truth.json``) or a ``.json`` path.  Returns the path written.
     ``ValueError`` for values JSON cannot hold (NaN, infinities, objects)."""
-    from ..outputs import atomic_write, check_output
+    from fruitimpact.impact.outputs import atomic_write, check_output
 
     if not isinstance(truth, dict):
         raise InputError(f"truth must be a dict; got {type(truth).__name__}", "truth")

@@ -64,10 +64,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...validation import InputError
-from ..recording import Recording
-from .binary import open_f32, open_npy
-from .common import (
+from fruitimpact.impact.validation import InputError
+from fruitimpact.signals.recording import Recording
+from fruitimpact.signals.read.binary import open_f32, open_npy
+from fruitimpact.signals.read.common import (
     CHUNK_SAMPLES,
     EXTENSIONS,
     FORCE_UNITS,
@@ -79,8 +79,8 @@ from .common import (
     check_file,
     check_rate,
 )
-from .csvtable import _column, open_csv  # noqa: F401 - _column: synth checks lane names it writes with it
-from .tdms import open_tdms
+from fruitimpact.signals.read.csvtable import _column, open_csv  # noqa: F401 - _column: synth checks lane names it writes with it
+from fruitimpact.signals.read.tdms import open_tdms
 
 _ALLOWED_EXTENSIONS = ", ".join(EXTENSIONS)
 #: Samples per lane of each chunk ``read_recording`` joins.

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import BLOCK_SAMPLES, RecordingSource, check_finite, error, need_rate, open_file, read_exactly, select
+from fruitimpact.signals.read.common import BLOCK_SAMPLES, RecordingSource, check_finite, error, need_rate, open_file, read_exactly, select
 
 
 def open_npy(path: Path, rate, column) -> RecordingSource:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...validation import InputError
+from fruitimpact.impact.validation import InputError
 
 #: Formats and their extensions (the first extension is the one written by default).
 FORMATS = {"csv": (".csv", ".txt"), "npy": (".npy",), "f32": (".f32", ".bin", ".raw"), "tdms": (".tdms",)}

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import (
+from fruitimpact.signals.read.common import (
     FORCE_UNITS,
     RATE_TOLERANCE,
     TIME_NAMES,

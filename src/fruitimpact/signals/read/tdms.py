@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .common import (
+from fruitimpact.signals.read.common import (
     BLOCK_SAMPLES,
     FORCE_UNITS,
     RATE_TOLERANCE,

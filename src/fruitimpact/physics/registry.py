@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine import codes as forces
-from . import laws
-from .families import FAMILIES, ForceFamily
+from fruitimpact.engine import codes as forces
+from fruitimpact.physics import laws
+from fruitimpact.physics.families import FAMILIES, ForceFamily
 
 
 @dataclass(frozen=True)

@@ -44,8 +44,8 @@ def read_line(path) -> list[TransferPoint]:
     unknown or missing columns, ragged rows, unknown surfaces, heights that are not positive."""
     import csv
 
-    from ..registries import SURFACE_CHOICES
-    from ..units import parse_quantity
+    from fruitimpact.impact.registries import SURFACE_CHOICES
+    from fruitimpact.impact.units import parse_quantity
 
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
@@ -115,10 +115,10 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``changes`` lists, best first, each (point, surface) with the line's incidence and mean bruise volume
     with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
     difference)."""
-    from ..batch import evaluation
-    from ..constants import STANDARD_GRAVITY
-    from ..library import surfaces
-    from ..validation import InputError
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.physics.constants import STANDARD_GRAVITY
+    from fruitimpact.library.catalogue import surfaces
+    from fruitimpact.impact.validation import InputError
 
     if isinstance(alternatives, str) or not all(isinstance(a, str) for a in alternatives):
         raise InputError("alternatives must be a sequence of library surface names", "alternatives")

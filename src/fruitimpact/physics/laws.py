@@ -101,7 +101,7 @@ def gharib_hurmuzlu(e):
 def exact_power_law(e):
     """χ solving (1 + χ) = (1 − e χ) exp((1 + e) χ): the exact restitution of F = K δ^n (1 + c δ̇),
     from the first integral of Hunt & Crossley 1975 (this package; docs/physics.md)."""
-    from ..engine.powerlaw import exact_x
+    from fruitimpact.engine.powerlaw import exact_x
 
     return exact_x(e)
 

@@ -23,25 +23,26 @@ import math
 
 import numpy as np
 
-from . import contact, library
-from .contact import hertz_contact_duration
-from .calibrate import TABLE_E_MIN
-from .calibrate import damping_factor as calibrated_damping_factor
-from .constants import STANDARD_GRAVITY
-from .engine.powerlaw import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
-from .inputs import InputColumns, read_columns
-from .models import DAMPING_LAWS
-from .registries import REGISTRIES
-from . import presets
-from .damage.assess import CRITERION_NAMES, bruise_columns
-from .engine.plastic import (PLASTIC_COLUMNS, crushing_characteristics, plastic_characteristics, winkler_stiffness,
+from fruitimpact.library import catalogue as library
+from fruitimpact.physics import hertz as contact
+from fruitimpact.physics.hertz import hertz_contact_duration
+from fruitimpact.physics.calibrate import TABLE_E_MIN
+from fruitimpact.physics.calibrate import damping_factor as calibrated_damping_factor
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
+from fruitimpact.impact.inputs import InputColumns, read_columns
+from fruitimpact.physics import DAMPING_LAWS
+from fruitimpact.impact.registries import REGISTRIES
+from fruitimpact.impact import presets
+from fruitimpact.damage.assess import CRITERION_NAMES, bruise_columns
+from fruitimpact.engine.plastic import (PLASTIC_COLUMNS, crushing_characteristics, plastic_characteristics, winkler_stiffness,
                              yield_pressure_of_force)
-from .quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
+from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
                          NUMERIC_INPUTS, PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
-from .solvers import SOLVERS, max_rk4_step, power_law_closed_forms
-from .status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
-from .labels import Labels
-from .validation import (MessageBook, WarningBook, conflict_message, implausible_message, nan_message,
+from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_forms
+from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
+from fruitimpact.impact.labels import Labels
+from fruitimpact.impact.validation import (MessageBook, WarningBook, conflict_message, implausible_message, nan_message,
                          range_message)
 
 #: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is

@@ -2,7 +2,7 @@
 
 Each ``Quantity`` says what a value is (name, symbol, label, doc), how it is
 shown (display unit and scale) and read (its dimension in
-``fruitimpact.units``), the range a value must lie in to be accepted
+``fruitimpact.impact.units``), the range a value must lie in to be accepted
 (``allowed``: outside it the input is refused with one line) and the range
 that is plausible for fruit (``plausible``: outside it the result carries a
 warning), its default, and the CLI option that sets it.  From this table come
@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY
-from .units import SI_UNIT, parse_quantity
+from fruitimpact.physics.constants import JONATHAN_APPLE, JONATHAN_RESTITUTION, JONATHAN_VELOCITY
+from fruitimpact.impact.units import SI_UNIT, parse_quantity
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ class Quantity:
     label : str
         Words and symbol for tables and axes (``peak force F_max``).
     dimension : str
-        Key of ``fruitimpact.units.UNITS``: how values with units are read.
+        Key of ``fruitimpact.impact.units.UNITS``: how values with units are read.
     unit : str
         Display unit of tables and figures.
     scale : float

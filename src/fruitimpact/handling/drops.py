@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
+from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 #: Impacts followed at most.
 MAX_IMPACTS = 50
@@ -85,10 +85,10 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         ``bruised`` (any impact), ``bruise_volume`` (accumulated), ``rest_time``,
         ``status`` and ``message``, ``warnings``.
     """
-    from ..batch import evaluate_inputs
-    from ..inputs import read_columns
-    from ..quantities import INPUTS
-    from ..validation import InputError
+    from fruitimpact.impact.evaluation import evaluate_inputs
+    from fruitimpact.impact.inputs import read_columns
+    from fruitimpact.impact.quantities import INPUTS
+    from fruitimpact.impact.validation import InputError
 
     for name in ("velocity", "drop_height"):
         if name in inputs:

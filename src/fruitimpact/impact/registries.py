@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
-from . import library
-from .models import CALIBRATIONS, DAMPING_LAWS
-from .solvers import SOLVERS
+from fruitimpact.library import catalogue as library
+from fruitimpact.physics import CALIBRATIONS, DAMPING_LAWS
+from fruitimpact.impact.solvers import SOLVERS
 
 #: ``--surface``: ``rigid`` (the default: the surface options as given, a rigid flat unless told otherwise)
 #: and the library's surfaces.

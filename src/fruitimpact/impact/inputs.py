@@ -26,10 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .labels import Labels, factorize
-from .quantities import INPUTS, NUMERIC_INPUTS, TEXT_INPUTS
-from .units import parse_quantity
-from .validation import MessageBook, nan_message, unreadable_message
+from fruitimpact.impact.labels import Labels, factorize
+from fruitimpact.impact.quantities import INPUTS, NUMERIC_INPUTS, TEXT_INPUTS
+from fruitimpact.impact.units import parse_quantity
+from fruitimpact.impact.validation import MessageBook, nan_message, unreadable_message
 
 
 def column_key(name) -> str:

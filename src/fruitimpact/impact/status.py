@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .engine.codes import (CONTACT_DURATION, MAX_DEFLECTION, PEAK_FORCE,
+from fruitimpact.engine.codes import (CONTACT_DURATION, MAX_DEFLECTION, PEAK_FORCE,
                               RESTITUTION)
-from .validation import MessageBook
+from fruitimpact.impact.validation import MessageBook
 
 OK, INACCURATE, FAILED, INVALID = 0, 1, 2, 3
 #: Status names by code (a categorical's categories).
@@ -59,7 +59,7 @@ def judge(values: np.ndarray, rows: np.ndarray, status: np.ndarray, messages: Me
     solver's characteristics of the same rows when the solver is ``checked``; ``time_scale``
     (rows → the undamped Hertz contact duration [s]) tells, for the rows without a result,
     an impact whose scales leave double precision from a solver that did not finish."""
-    from .engine.checks import COLLAPSED, ENERGY_CREATED, NO_REBOUND, NOT_FINITE, classify
+    from fruitimpact.engine.checks import COLLAPSED, ENERGY_CREATED, NO_REBOUND, NOT_FINITE, classify
 
     outcome = classify(values, np.asarray(velocity[rows], dtype=float), solver.tolerance)
     if not outcome.any():  # every row physical: the common case, settled in one pass

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine.codes import N_CHARACTERISTICS
+from fruitimpact.engine.codes import N_CHARACTERISTICS
 
 # The compiled engine is imported inside the functions that run it: the registry
 # (and the command line's --help) must not start numba.
@@ -32,7 +32,7 @@ ADAPTIVE_RTOL = 1e-10
 def max_rk4_step(mass, stiffness, velocity):
     """Coarsest accepted RK4 step [s]: 1/20 of the undamped Hertz contact duration,
     a lower bound of T for the laws here (damping lengthens the contact)."""
-    from .contact import hertz_contact_duration
+    from fruitimpact.physics.hertz import hertz_contact_duration
 
     with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
         return hertz_contact_duration(mass, stiffness, velocity) / RK4_MIN_STEPS_PER_CONTACT
@@ -43,7 +43,7 @@ def power_law_closed_forms(stiffness, damping_factor, mass, velocity, exponent: 
     δ_max = [(n+1) m (x - ln(1+x)) / (K c²)]^(1/(n+1)), x = c v0, and e the root
     of (1 + x) = (1 - e x) exp((1 + e) x) (Hunt & Crossley 1975; docs/physics.md).
     A self-check beside the solvers' numbers, independent of their quadrature."""
-    from .engine.powerlaw import exact_restitution, r_array
+    from fruitimpact.engine.powerlaw import exact_restitution, r_array
 
     stiffness, damping_factor, mass, velocity = (np.asarray(a, dtype=float) for a in
                                                  (stiffness, damping_factor, mass, velocity))
@@ -56,12 +56,12 @@ def power_law_closed_forms(stiffness, damping_factor, mass, velocity, exponent: 
 
 
 def _accurate_batch(law, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
-    from .calibrate import law_params
-    from .engine.powerlaw import powerlaw_characteristics
+    from fruitimpact.physics.calibrate import law_params
+    from fruitimpact.engine.powerlaw import powerlaw_characteristics
 
     if law.force_family.first_integral:
         return powerlaw_characteristics(mass, stiffness, damping_factor, velocity, radius, tabulated=tabulated)
-    from .engine.adaptive import adaptive_characteristics
+    from fruitimpact.engine.adaptive import adaptive_characteristics
 
     rows = len(mass)
     return adaptive_characteristics(np.full(rows, law.family), law_params(law.family, stiffness, damping_factor),
@@ -69,9 +69,9 @@ def _accurate_batch(law, stiffness, damping_factor, mass, velocity, radius, step
 
 
 def _rk4_batch(law, stiffness, damping_factor, mass, velocity, radius, step, tabulated=None):
-    from .calibrate import law_params
-    from .engine.powerlaw import PARALLEL_MIN_ROWS
-    from .engine.rk4 import rk4_batch, rk4_batch_serial
+    from fruitimpact.physics.calibrate import law_params
+    from fruitimpact.engine.powerlaw import PARALLEL_MIN_ROWS
+    from fruitimpact.engine.rk4 import rk4_batch, rk4_batch_serial
 
     rows = len(mass)
     out = np.empty((rows, N_CHARACTERISTICS))
@@ -86,13 +86,13 @@ def _rk4_batch(law, stiffness, damping_factor, mass, velocity, radius, step, tab
 def _accurate_curves(law, stiffness, damping_factor, mass, velocity, step, times):
     """δ, δ̇, F of rows of impacts at ``times`` (rows, points): the exact phase curve, or
     the adaptive integrator's dense output."""
-    from .calibrate import law_params
+    from fruitimpact.physics.calibrate import law_params
 
     if law.force_family.first_integral:
-        from .engine.powerlaw import powerlaw_curves_batch
+        from fruitimpact.engine.powerlaw import powerlaw_curves_batch
 
         return powerlaw_curves_batch(mass, stiffness, damping_factor, velocity, times)
-    from .engine.adaptive import adaptive_curves
+    from fruitimpact.engine.adaptive import adaptive_curves
 
     params = law_params(law.family, stiffness, damping_factor)
     out = [np.empty(times.shape) for _ in range(3)]
@@ -113,8 +113,8 @@ def _accurate_samples(law, stiffness, damping_factor, mass, velocity, step, poin
 def _rk4_samples(law, stiffness, damping_factor, mass, velocity, step, points=None, duration=None):
     """The RK4 grid of one impact: (t, δ, δ̇, F), the last sample at the interpolated
     separation.  ``ValueError`` if the contact does not end within ``RK4_MAX_STEPS``."""
-    from .calibrate import law_params
-    from .engine.rk4 import rk4_impact
+    from fruitimpact.physics.calibrate import law_params
+    from fruitimpact.engine.rk4 import rk4_impact
 
     estimate = 40.0 * ((1.25 * mass * velocity ** 2 / stiffness) ** 0.4 / velocity) / step
     size = int(min(RK4_MAX_STEPS, max(estimate, 1000))) + 2
@@ -131,8 +131,8 @@ def _rk4_curves(law, stiffness, damping_factor, mass, velocity, step, times):
     """δ, δ̇, F of rows of impacts at ``times`` (rows, points): cubic Hermite interpolation
     of each row's RK4 grid (δ with δ̇ as its slope, δ̇ with -F/m), and the law's force at
     the interpolated state; after separation the separation state with F = 0."""
-    from .calibrate import law_params
-    from .engine.forces import contact_force
+    from fruitimpact.physics.calibrate import law_params
+    from fruitimpact.engine.forces import contact_force
 
     step = np.broadcast_to(step, np.shape(mass))
     out = [np.empty(times.shape) for _ in range(3)]

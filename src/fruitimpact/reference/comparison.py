@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .calibrate import achieved_restitution, damping_factor
-from .engine.powerlaw import exact_restitution
-from .impact import Fruit, resolve_stiffness
-from .models import DAMPING_LAWS
+from fruitimpact.physics.calibrate import achieved_restitution, damping_factor
+from fruitimpact.engine.powerlaw import exact_restitution
+from fruitimpact.impact.simulation import Fruit, resolve_stiffness
+from fruitimpact.physics import DAMPING_LAWS
 
 DEFAULT_TARGETS = (0.1, 0.3, 0.5, 0.7, 0.9)
 DEFAULT_VELOCITIES = (0.5, 1.0, 3.0)

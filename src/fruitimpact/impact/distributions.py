@@ -1,7 +1,7 @@
 """Distributions of impact inputs for Monte Carlo populations.
 
 A spec string names a distribution and its parameters, each parameter a number
-with an optional unit of the input's dimension (``fruitimpact.units``)::
+with an optional unit of the input's dimension (``fruitimpact.impact.units``)::
 
     0.115 | 115g                      constant
     normal(mean, sd)                  normal (Gaussian)
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .units import parse_quantity
+from fruitimpact.impact.units import parse_quantity
 
 _CALL = re.compile(r"^\s*([A-Za-z_][A-Za-z_0-9]*)\s*\((.*)\)\s*$", re.DOTALL)
 #: Below this probability of [lo, hi] under the untruncated normal, truncnormal is refused.

@@ -45,8 +45,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .engine.codes import RESTITUTION
-from .engine.powerlaw import exact_x
+from fruitimpact.engine.codes import RESTITUTION
+from fruitimpact.engine.powerlaw import exact_x
 
 #: Exact-calibration table of the laws without a first integral: its range in
 #: e, the panels and degree of its Chebyshev series, the integrator's rtol.
@@ -62,7 +62,7 @@ _TINY = np.finfo(float).tiny
 def law_params(family, stiffness, damping_factor, exponent=1.5):
     """Parameter matrix for the compiled force of ``family`` (rows of impacts): see
     ``models.families.ForceFamily.params``."""
-    from .models.families import FAMILIES
+    from fruitimpact.physics.families import FAMILIES
 
     return FAMILIES[family].params(stiffness, damping_factor, exponent)
 
@@ -70,14 +70,14 @@ def law_params(family, stiffness, damping_factor, exponent=1.5):
 def achieved_restitution(law, damping_factor, mass, stiffness, velocity):
     """Restitution the law really produces with this damping (compiled integrator
     for non-power-law families)."""
-    from .engine.adaptive import DEFAULT_RTOL
+    from fruitimpact.engine.adaptive import DEFAULT_RTOL
 
     return _restitution(law, damping_factor, mass, stiffness, velocity, DEFAULT_RTOL)
 
 
 def _restitution(law, damping_factor, mass, stiffness, velocity, rtol):
     """``achieved_restitution`` with the integrator at ``rtol``."""
-    from .engine.adaptive import adaptive_characteristics
+    from fruitimpact.engine.adaptive import adaptive_characteristics
 
     mass, stiffness, velocity, damping_factor = np.broadcast_arrays(
         *(np.atleast_1d(np.asarray(a, dtype=float)) for a in (mass, stiffness, velocity, damping_factor)))

@@ -16,7 +16,7 @@ import csv
 import math
 from importlib import resources
 
-from .impact import Fruit, simulate
+from fruitimpact.impact.simulation import Fruit, simulate
 
 PAPER_MASS = 0.115  # kg, the worked example's M (Table 1 does not print it)
 PAPER_DIAMETER = 0.065  # m
@@ -36,7 +36,7 @@ KNOWN_MISPRINTS = {
 def load_table1() -> list[dict]:
     """Table 1 as printed (units in the CSV header: V m/s, E MPa, k_c 1e6 N/m^1.5,
     F N, δ_max 1e-5 m, T and t_c 1e-4 s, C 1e4 N/s)."""
-    text = resources.files("fruitimpact").joinpath("data/table1.csv").read_text()
+    text = resources.files("fruitimpact.reference").joinpath("data/table1.csv").read_text()
     rows = [line for line in text.splitlines() if line and not line.startswith("#")]
     table = []
     for row in csv.DictReader(rows):
@@ -128,7 +128,7 @@ def _entry(row, law_key):
 
 
 def _eq9(modulus):
-    from .contact import rigid_plane_stiffness
+    from fruitimpact.physics.hertz import rigid_plane_stiffness
 
     return float(rigid_plane_stiffness(modulus, PAPER_POISSON, PAPER_DIAMETER))
 
@@ -276,8 +276,8 @@ def write_paper_figures(directory) -> list[str]:
     overlaying the paper's RK4 grid, the accurate solution of the same λ = 1.5 α k_c
     (eq 5), and the accurate solution calibrated exactly to k = 1 − α V_i (eq 6)."""
 
-    from .outputs import check_output_folder
-    from .plotting import impact_figure, save_figure
+    from fruitimpact.impact.outputs import check_output_folder
+    from fruitimpact.plotting import impact_figure, save_figure
 
     out = check_output_folder(directory, "directory", create=True)
     fruit = Fruit(mass=PAPER_MASS, diameter=PAPER_DIAMETER, modulus=3e6, poisson=PAPER_POISSON, stiffness=0.835e6)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine import codes as forces
+from fruitimpact.engine import codes as forces
 
 #: Undamped Hertz contact duration T = HERTZ_DURATION_FACTOR · δ_H / v0 = (4/5) B(1/2, 2/5) δ_H/v0.
 HERTZ_DURATION_FACTOR = 0.8 * math.gamma(0.5) * math.gamma(0.4) / math.gamma(0.9)

@@ -248,7 +248,7 @@ class Surface:
 # ----------------------------------------------------------------------------------------------- loading
 
 def _read(filename: str) -> list[dict[str, str]]:
-    text = resources.files("fruitimpact").joinpath("data", filename).read_text(encoding="utf-8")
+    text = resources.files("fruitimpact.library").joinpath("data", filename).read_text(encoding="utf-8")
     lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
     return list(csv.DictReader(lines))
 

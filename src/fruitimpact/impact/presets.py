@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import library
-from .quantities import INPUTS
+from fruitimpact.library import catalogue as library
+from fruitimpact.impact.quantities import INPUTS
 
 #: The library's names of fruit properties that differ from the inputs' names.
 _FRUIT_KEYS = {"bruise_threshold_energy": "bruise_energy"}
@@ -188,7 +188,7 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
     property whose library range is one value stays that value; one the entry lacks is left to the inputs' own
     rules (a criterion needing it is refused).  The diameter follows each fruit's mass (drawn here or given)
     at the library density unless the diameter is given.  ``fruit`` must be a library name."""
-    from .distributions import SplitNormal
+    from fruitimpact.impact.distributions import SplitNormal
 
     entries = library.fruits()
     if fruit not in entries:
@@ -233,7 +233,7 @@ def fruit_criterion(fruit: str | None, criterion: str | None) -> str:
     name = fruit or INPUTS["fruit"].default
     entry = library.fruits().get(name)
     if entry is None or entry.criterion is None:
-        from .validation import InputError
+        from fruitimpact.impact.validation import InputError
 
         raise InputError(f"criterion must be given: the {name} entry of the fruit library names no bruise criterion "
                          f"the literature supports (pressure, shear or energy; the onset height changes by an "

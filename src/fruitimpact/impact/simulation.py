@@ -21,13 +21,13 @@ from functools import cached_property
 
 import numpy as np
 
-from .calibrate import law_params
-from .constants import STANDARD_GRAVITY
-from .engine import forces
-from .models import FAMILIES, ForceFamily
-from .quantities import INPUTS
-from .status import STATUS_NAMES
-from .validation import InputError, check_choice, check_value, read_value
+from fruitimpact.physics.calibrate import law_params
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+from fruitimpact.engine import forces
+from fruitimpact.physics import FAMILIES, ForceFamily
+from fruitimpact.impact.quantities import INPUTS
+from fruitimpact.impact.status import STATUS_NAMES
+from fruitimpact.impact.validation import InputError, check_choice, check_value, read_value
 
 
 def _unvalidated(cls, values: dict):
@@ -242,7 +242,7 @@ class Curves:
     def to_csv(self, path, argument: str = "path") -> None:
         """Write the curves as CSV (columns time_s, deflection_m, rate_m_per_s, force_N), checked
         first and written atomically (``outputs``); ``ValueError`` naming ``argument`` otherwise."""
-        from .outputs import CSV_FORMAT, atomic_write, check_output
+        from fruitimpact.impact.outputs import CSV_FORMAT, atomic_write, check_output
 
         check_output(path, argument, CSV_FORMAT)
         header = "time_s,deflection_m,rate_m_per_s,force_N"
@@ -279,13 +279,13 @@ class ImpactResult:
     @cached_property
     def curves(self) -> Curves:
         """δ(t), δ̇(t), F(t) over the contact, from the same solver (the RK4 grid for rk4)."""
-        from .models import get_law
-        from .solvers import get_solver
+        from fruitimpact.physics import get_law
+        from fruitimpact.impact.solvers import get_solver
 
         if not math.isfinite(self.characteristics.contact_duration):
             raise ValueError(f"no curves: the impact {self.status} ({self.message})")
         if self.plastic:  # elastic-plastic or layered: the plastic engine's own curves
-            from .engine.plastic import plastic_curves
+            from fruitimpact.engine.plastic import plastic_curves
 
             return Curves(*plastic_curves(self.curve_points, **self.plastic_arguments))
         solver = get_solver(self.inputs.method)
@@ -332,7 +332,7 @@ def impact_velocity(drop_height: float) -> float:
 
 def resolve_stiffness(fruit: Fruit, surface: Surface = RIGID_PLANE) -> tuple[float, float]:
     """(k_c [N/m^1.5], effective radius R [m]) of the fruit on the surface."""
-    from . import contact
+    from fruitimpact.physics import hertz as contact
 
     radius = float(contact.effective_radius(fruit.radius, surface.radius))
     if fruit.stiffness is not None:
@@ -359,7 +359,7 @@ def _row(fruit, surface, keywords: dict) -> dict:
     elif surface is not None:
         raise InputError(f"surface must be a Surface, a surface of the library (fruitimpact surfaces) or None for "
                          f"a rigid plane; got {surface!r}", "surface")
-    from .registries import REGISTRIES
+    from fruitimpact.impact.registries import REGISTRIES
 
     for name, value in keywords.items():
         if name not in INPUTS:
@@ -430,8 +430,8 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
         solver failed or missed its accuracy; inputs out of range raise ``ValueError``
         (an ``InputError`` naming the argument) instead.
     """
-    from .batch import evaluate_inputs
-    from .inputs import read_columns
+    from fruitimpact.impact.evaluation import evaluate_inputs
+    from fruitimpact.impact.inputs import read_columns
 
     keywords = dict(velocity=velocity, drop_height=drop_height, restitution=restitution, alpha=alpha,
                     damping=damping, model=model, calibration=calibration, method=method, step=step, **inputs)
@@ -454,18 +454,18 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
                                calibration=columns["calibration"], method=columns["method"],
                                step=float(columns["step"]), damping=given["damping"],
                                target_restitution=target if math.isfinite(target) else None)
-    from .models import get_law
+    from fruitimpact.physics import get_law
 
     law = get_law(inputs_used.model)
     contact_law = ContactLaw(stiffness=float(columns["law_stiffness"]), damping_factor=float(columns["damping_factor"]),
                              family=law.family, clamp=law.clamp)
-    from .engine.powerlaw import CHARACTERISTIC_COLUMNS
+    from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS
 
     characteristics = Characteristics(**{name: float(columns[name]) for name in CHARACTERISTIC_COLUMNS},
                                       max_deflection_closed_form=float(result.closed_forms[0, 0]),
                                       restitution_closed_form=float(result.closed_forms[0, 1]))
     message = messages.text(0) or "ok"
-    from .quantities import DAMAGE_NAMES
+    from fruitimpact.impact.quantities import DAMAGE_NAMES
 
     damage = {name: float(columns[name]) for name in DAMAGE_NAMES}
     damage["bruised"] = None if math.isnan(damage["bruised"]) else bool(damage["bruised"])

@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from .quantities import INPUTS, Quantity, Range
-from .units import UNITS, parse_quantity
+from fruitimpact.impact.quantities import INPUTS, Quantity, Range
+from fruitimpact.impact.units import UNITS, parse_quantity
 
 
 class InputError(ValueError):

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from ..constants import STANDARD_GRAVITY
+from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 #: The heights searched [m]: below the lowest the fruit bruises "from any height", above the highest never.
 LOWEST, HIGHEST = 1e-5, 10.0
@@ -34,7 +34,7 @@ SENSITIVITY_INPUTS = {"pressure": ("modulus", "mass", "failure_stress"),
 
 
 def _margins(table: dict, heights: np.ndarray):
-    from ..batch import evaluation
+    from fruitimpact.impact.evaluation import evaluation
 
     result = evaluation({**table, "drop_height": heights})
     return np.asarray(result.columns["bruise_margin"], dtype=float), result
@@ -109,8 +109,8 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
         ``safe_velocity`` [m/s], ``criterion``, ``message``, ``sensitivity`` (name →
         elasticity), and the bruise figures at that height.
     """
-    from ..quantities import INPUTS
-    from ..validation import InputError
+    from fruitimpact.impact.quantities import INPUTS
+    from fruitimpact.impact.validation import InputError
 
     for name in ("velocity", "drop_height"):
         if inputs.get(name) is not None:
@@ -118,7 +118,7 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     unknown = [name for name in inputs if name not in INPUTS]
     if unknown:
         raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
-    from ..presets import fruit_criterion
+    from fruitimpact.impact.presets import fruit_criterion
 
     criterion = inputs.get("criterion")
     if criterion == "none":
@@ -132,7 +132,7 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     names = SENSITIVITY_INPUTS.get(criterion, ())
     cases = [given]
     if sensitivity:
-        from ..batch import evaluation
+        from fruitimpact.impact.evaluation import evaluation
 
         base = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
         for name in names:
@@ -152,7 +152,7 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
             report["sensitivity"][name] = (math.log(up / down) / math.log((1 + SENSITIVITY_STEP) /
                                                                          (1 - SENSITIVITY_STEP)) if ok else math.nan)
     if math.isfinite(height) and height > 0:
-        from ..batch import evaluation
+        from fruitimpact.impact.evaluation import evaluation
 
         at = evaluation({name: [value] for name, value in {**given, "drop_height": height}.items()})
         for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy", "absorbed_energy",
@@ -163,9 +163,9 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
 
 def _check_row(given: dict) -> None:
     """Refuse bad inputs before the search, with the table's message."""
-    from ..batch import evaluation
-    from ..status import INVALID
-    from ..validation import InputError
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.impact.status import INVALID
+    from fruitimpact.impact.validation import InputError
 
     probe = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
     if probe.status[0] == INVALID:
