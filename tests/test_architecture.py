@@ -121,6 +121,29 @@ def test_import_contracts_hold():
     assert "0 broken" in done.stdout
 
 
+@pytest.mark.parametrize("argv", [["--help"], ["simulate", "--help"], ["simulate", "--mass", "-1"],
+                                  ["drop", "--model", "nonsense"], ["safe-height", "--diameter", "65 parsecs"]])
+def test_the_console_path_answers_help_and_usage_errors_without_numba(argv):
+    """Issue 15 item 4: the console script (``main()`` with no argv: the path that starts numba's target for
+    the CLI) answers --help and a usage error before numba or pandas are imported, so in a fraction of
+    a second (the time itself is measured in benchmarks/startup.py, not here)."""
+    code = ("import sys\nfrom fruitimpact.cli import main\nsys.argv = ['fruitimpact'] + sys.argv[1:]\n"
+            "try:\n    status = main()\nexcept SystemExit as exc:\n    status = exc.code\n"
+            "print('STATUS', status, file=sys.stderr)\n"
+            "for name in ('numba', 'pandas', 'pyarrow', 'matplotlib'):\n    print(name, name in sys.modules, file=sys.stderr)\n")
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120)
+    lines = done.stderr.splitlines()
+    loaded = dict(line.split() for line in lines if line.split()[-1:] in (["True"], ["False"]))
+    assert loaded == {"numba": "False", "pandas": "False", "pyarrow": "False", "matplotlib": "False"}, done.stderr
+    status = next(line.split()[1] for line in lines if line.startswith("STATUS"))
+    if argv[-1] == "--help":
+        assert status in ("0", "None") and "usage:" in done.stdout
+    else:
+        assert status == "2"
+        message = [line for line in lines if line.startswith("fruitimpact")]
+        assert len(message) == 1 and f"argument --{argv[1].lstrip('-')}" in message[0], done.stderr
+
+
 def test_help_starts_no_numba_and_no_pandas():
     code = ("import sys\nfrom fruitimpact.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
             "for name in ('numba', 'pandas', 'matplotlib', 'pyarrow'):\n"

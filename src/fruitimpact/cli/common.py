@@ -15,7 +15,7 @@ import sys
 
 from fruitimpact.impact.quantities import INPUTS, option_of
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import conflict_message
+from fruitimpact.impact.validation import check_choice, check_value, conflict_message
 
 from fruitimpact.cli import PROG  # noqa: E402,F401  (defined by the package first; the commands import it from here)
 
@@ -99,10 +99,27 @@ def _add_impact_options(parser: argparse.ArgumentParser) -> None:
         if not quantity.option:
             continue
         if quantity.numeric:
-            group.add_argument(quantity.option, metavar="VALUE", help=_help(quantity))
+            group.add_argument(quantity.option, metavar="VALUE", help=_help(quantity), type=_checked(quantity.name))
         else:
-            choices = "{" + ",".join(REGISTRIES[quantity.choices]) + "}"
-            group.add_argument(quantity.option, metavar=choices, help=f"{quantity.doc} (default {quantity.default})")
+            registry = REGISTRIES[quantity.choices]
+            choices = "{" + ",".join(registry) + "}"
+            group.add_argument(quantity.option, metavar=choices, help=f"{quantity.doc} (default {quantity.default})",
+                               type=_checked(quantity.name, registry))
+
+
+def _checked(name: str, registry=None):
+    """An argparse ``type`` that checks an impact option with the library's own check (``check_value`` or
+    ``check_choice``, the same message) while parsing, so that a usage error is answered before any work or
+    numba start-up (issue 15 item 4).  It returns the text as typed: the library reads it again."""
+    def check(text: str) -> str:
+        try:
+            check_value(name, text) if registry is None else check_choice(name, text, registry)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    check.__name__ = name  # argparse names the type in some of its own messages
+    return check
 
 
 def _simulate_kwargs(args) -> dict:
@@ -203,12 +220,21 @@ def _attach_negative_values(argv: list[str]) -> list[str]:
 
 
 def _numba_without_blas() -> None:
-    """Start numba's CPU target without letting it import SciPy's BLAS.
+    """Start numba's CPU target, when numba is first imported, without letting it import SciPy's BLAS.
 
     On its first compiled call numba imports ``scipy.linalg.cython_blas`` (about
     0.2 s) only to offer ``np.dot`` inside compiled code, which the engine never
     uses.  In the CLI's own process we refuse that import while the target
-    initialises; library users (who may want numba's np.dot) are not affected."""
+    initialises; library users (who may want numba's np.dot) are not affected.
+    Nothing happens until a command imports numba, so ``--help`` and usage errors
+    (checked before any work) never start it (issue 15 item 4)."""
+    if "numba" in sys.modules:
+        _start_numba_target()
+    elif not any(isinstance(finder, _AfterNumbaImport) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _AfterNumbaImport())
+
+
+def _start_numba_target() -> None:
     if "scipy.linalg.cython_blas" in sys.modules:
         return
     sys.modules["scipy.linalg.cython_blas"] = None  # makes the import raise ImportError
@@ -219,6 +245,27 @@ def _numba_without_blas() -> None:
     finally:
         del sys.modules["scipy.linalg.cython_blas"]
 
+
+class _AfterNumbaImport:
+    """A one-shot import hook: once ``import numba`` has run, start its target (``_start_numba_target``)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "numba":
+            return None
+        sys.meta_path.remove(self)
+        import importlib.util
+
+        spec = importlib.util.find_spec(name)
+        if spec is None or spec.loader is None:
+            return spec
+        run_module = spec.loader.exec_module
+
+        def exec_module(module):
+            run_module(module)
+            _start_numba_target()
+
+        spec.loader.exec_module = exec_module
+        return spec
 
 
 # --------------------------------------------------------------------------------------------- lots

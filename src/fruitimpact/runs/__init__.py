@@ -19,7 +19,7 @@ One module per job:
 * ``locking``: one run at a time on a work folder and on an output;
 * ``engines``: in-process and Dask;
 * ``summaries``: status counts, streamed statistics, percentiles;
-* ``execute``: the driver.
+* ``driver``: the driver (``execute``).
 
 Population members are drawn from generators derived from
 ``SeedSequence(seed, spawn_key=(block, stream))`` for fixed blocks of
@@ -27,16 +27,41 @@ Population members are drawn from generators derived from
 number: the same for any chunk size, engine, or interruption.
 """
 
-from fruitimpact.plotting.runs import histogram_figure, sweep_figure
-from fruitimpact.impact.quantities import CHARACTERISTICS, DEFAULT_SUMMARY, INPUTS, Quantity
-from fruitimpact.runs.chunks import evaluate_rows, run_chunk
-from fruitimpact.runs.engines import ENGINES, DaskEngine, InProcessEngine
-from fruitimpact.runs import execute as execute_module  # noqa: F401  (the module, for tests that patch it)
-from fruitimpact.runs.execute import default_workdir, execute, merge_parts, read_column
-from fruitimpact.runs.plan import (BLOCK_ROWS, CHUNK_ROWS, MAX_AXIS_VALUES, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES,
-                   SAMPLE_ROWS, Plan, RunError, Threshold, characteristic, characteristics_list)
-from fruitimpact.runs.sources import Axis, GridSource, PopulationSource, TableSource, parse_axis, table_format
-from fruitimpact.runs.summaries import RunSummary
+import importlib
+
+# Imported on first use (PEP 562), so that the CLI's parser can read the limits of a run without
+# loading pyarrow, the engine or plotting.
+_EXPORTS = {
+    "histogram_figure": "fruitimpact.plotting.runs", "sweep_figure": "fruitimpact.plotting.runs",
+    "CHARACTERISTICS": "fruitimpact.impact.quantities", "DEFAULT_SUMMARY": "fruitimpact.impact.quantities",
+    "INPUTS": "fruitimpact.impact.quantities", "Quantity": "fruitimpact.impact.quantities",
+    "evaluate_rows": "fruitimpact.runs.chunks", "run_chunk": "fruitimpact.runs.chunks",
+    "ENGINES": "fruitimpact.runs.engines", "DaskEngine": "fruitimpact.runs.engines",
+    "InProcessEngine": "fruitimpact.runs.engines",
+    "default_workdir": "fruitimpact.runs.driver", "execute": "fruitimpact.runs.driver",
+    "merge_parts": "fruitimpact.runs.driver", "read_column": "fruitimpact.runs.driver",
+    "RunSummary": "fruitimpact.runs.summaries",
+    **{name: "fruitimpact.runs.plan" for name in (
+        "BLOCK_ROWS", "CHUNK_ROWS", "MAX_AXIS_VALUES", "MAX_CHUNK_ROWS", "MAX_ROWS", "MAX_SAMPLE_ROWS",
+        "PERCENTILES", "SAMPLE_ROWS", "Plan", "RunError", "Threshold", "characteristic", "characteristics_list")},
+    **{name: "fruitimpact.runs.sources" for name in (
+        "Axis", "GridSource", "PopulationSource", "TableSource", "parse_axis", "table_format")},
+}
+
+
+_MODULES = ("chunks", "driver", "engines", "locking", "plan", "sources", "summaries", "workdir")
+
+
+def __getattr__(name: str):
+    if name == "execute_module":  # the driver module itself, for tests that patch it
+        return importlib.import_module("fruitimpact.runs.driver")
+    if name in _MODULES:
+        return importlib.import_module(f"fruitimpact.runs.{name}")
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'fruitimpact.runs' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
+
 
 __all__ = ["BLOCK_ROWS", "CHARACTERISTICS", "CHUNK_ROWS", "DEFAULT_SUMMARY", "ENGINES", "INPUTS", "MAX_AXIS_VALUES",
            "MAX_CHUNK_ROWS", "MAX_ROWS", "MAX_SAMPLE_ROWS", "PERCENTILES", "SAMPLE_ROWS", "Axis", "DaskEngine",

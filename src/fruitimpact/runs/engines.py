@@ -11,7 +11,6 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from fruitimpact.runs import chunks
 from fruitimpact.runs.plan import RunError
 
 #: A Dask scheduler address: ``tcp://host:port``, ``host:port`` (no spaces).
@@ -33,8 +32,10 @@ class InProcessEngine:
     name = "inprocess"
 
     def run(self, plan, payloads, workdir: str, done) -> None:
+        from fruitimpact.runs.chunks import run_chunk  # here: the CLI parser reads ENGINES cheaply
+
         for index, payload in payloads:
-            done(chunks.run_chunk(plan, index, payload, workdir, keep_rows=True))
+            done(run_chunk(plan, index, payload, workdir, keep_rows=True))
 
 
 @dataclass(frozen=True)
@@ -53,6 +54,8 @@ class DaskEngine:
             check_scheduler(self.scheduler)
 
     def run(self, plan, payloads, workdir: str, done) -> None:
+        from fruitimpact.runs.chunks import run_chunk  # here: the CLI parser reads ENGINES cheaply
+
         import logging
 
         try:
@@ -75,7 +78,7 @@ class DaskEngine:
             shared = client.scatter(plan, broadcast=True)
             running = as_completed(with_results=True)
             for index, payload in payloads:
-                running.add(client.submit(chunks.run_chunk, shared, index, payload, workdir, 1, pure=False))
+                running.add(client.submit(run_chunk, shared, index, payload, workdir, 1, pure=False))
                 while running.count() >= 2 * slots:  # bounded: at most two chunks per worker thread in flight
                     done(next(running)[1])
             for _, result in running:
