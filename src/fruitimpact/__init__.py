@@ -22,6 +22,22 @@ _EXPORTS = {
     "Surface": "impact.simulation", "impact_velocity": "impact.simulation", "simulate": "impact.simulation",
     "CALIBRATIONS": "physics", "DAMPING_LAWS": "physics", "Calibration": "physics", "DampingLaw": "physics",
     "SOLVERS": "impact.solvers", "evaluate": "impact.evaluation",
+    # one function per task (issue 15 item 2): the CLI command it matches is in brackets
+    "drop": "handling.drops",                                   # fruitimpact drop
+    "safe_height": "handling.heights", "risk_map": "handling.heights",  # fruitimpact safe-height [--map]
+    "audit_line": "handling.line", "read_line": "handling.line",        # fruitimpact line
+    "analyze": "signals.offline",                               # fruitimpact analyze
+    "read_recording": "signals.read", "open_recording": "signals.read", "Recording": "signals.recording",
+    "fit_impact": "signals.fit",
+    "Detector": "signals.detect", "DetectorSettings": "signals.detect",
+    "StreamAnalyzer": "signals.stream",                         # fruitimpact stream (push samples, get impacts)
+    "calibrate_classes": "signals.sort:calibrate", "confusion_matrix": "signals.sort:confusion",  # fruitimpact classes
+    "FirmnessClasses": "signals.sort",
+    "synthesize": "signals.synth", "SensorModel": "signals.synth", "Population": "signals.synth",
+    "write_recording": "signals.synth",                         # fruitimpact synth
+    "fruits": "library", "surfaces": "library",                 # fruitimpact fruits / surfaces
+    "paper_report": "reference.paper",                          # fruitimpact paper
+    "restitution_table": "reference.comparison",                # fruitimpact models
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]
@@ -31,7 +47,8 @@ def __getattr__(name: str):
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'fruitimpact' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    module, _, attribute = module.partition(":")  # "module:attribute" where the public name differs
+    value = getattr(importlib.import_module(f".{module}", __name__), attribute or name)
     globals()[name] = value
     return value
 

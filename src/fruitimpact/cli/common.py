@@ -277,19 +277,10 @@ def add_spread_option(parser) -> None:
 
 
 def lot_distributions(args, fruit: str | None, given: list[str], criterion: str | None):
-    """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
-    (the default fruit when None): the library spreads of the inputs not in ``given`` (issue 14 item 4; the
-    bruise inputs only with a criterion), none with ``--no-spreads``."""
-    from fruitimpact.impact.presets import lot_spreads
+    """``impact.presets.lot_distributions`` with ``--no-spreads``; its error names ``--fruit``."""
+    from fruitimpact.impact.presets import lot_distributions as library_lot
 
-    fruit = fruit or INPUTS["fruit"].default
-    if args.no_spreads:
-        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",)
-    try:
-        spreads = lot_spreads(fruit, given, bruise=criterion not in (None, "none"))
-    except ValueError as exc:
-        raise UsageError(f"argument --fruit: {exc}") from None
-    return spreads.distributions, spreads.diameter_density, spreads.described
+    return _library_call(library_lot, fruit, given, criterion, spreads=not args.no_spreads)
 
 
 def print_spreads(command: str, lines) -> None:

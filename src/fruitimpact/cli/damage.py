@@ -10,12 +10,6 @@ from fruitimpact.impact.registries import REGISTRIES as REGISTRY_INPUTS
 from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
                      dump_json, lot_distributions, print_spreads)
 
-#: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
-MAP_HEIGHTS = 30
-#: Moduli of a firmness map [Pa].
-MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
-
-
 def _without_velocity(args) -> dict:
     kwargs = _simulate_kwargs(args)
     for name in ("velocity",):
@@ -82,42 +76,6 @@ def cmd_drop(args) -> int:
 
 
 # ---------------------------------------------------------------------------------------- safe height
-def _risk_map(kwargs: dict, by: str):
-    """Rows (dicts) of a bruise-risk map: height × surface or height × modulus, and the safe height of
-    each column, from one evaluation of the whole grid and one root search."""
-    import numpy as np
-
-    from fruitimpact.impact.evaluation import evaluation
-    from fruitimpact.handling.heights import safe_heights
-    from fruitimpact.impact.registries import SURFACE_CHOICES
-
-    heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
-    if by == "surface":
-        columns = [name for name in SURFACE_CHOICES if name not in ("rigid",)]
-        key = "surface"
-    else:
-        columns = list(MAP_MODULI)
-        key = "modulus"
-    base = {name: value for name, value in kwargs.items() if name not in ("drop_height", key)}
-    n = len(columns) * heights.size
-    table = {name: [value] * n for name, value in base.items()}
-    table[key] = [c for c in columns for _ in heights]
-    table["drop_height"] = [h for _ in columns for h in heights]
-    result = _library_call(evaluation, table)
-    rows = []
-    for i in range(n):
-        rows.append({key: table[key][i], "drop_height": table["drop_height"][i],
-                     "bruise_margin": float(result.columns["bruise_margin"][i]),
-                     "bruised": float(result.columns["bruised"][i]),
-                     "bruise_volume": float(result.columns["bruise_volume"][i]),
-                     "peak_force": float(result.columns["peak_force"][i]),
-                     "status": "ok" if result.status[i] == 0 else result.messages.text(i)})
-    safe_table = {name: [value] * len(columns) for name, value in base.items()}
-    safe_table[key] = columns
-    safe, _ = safe_heights(safe_table, len(columns))
-    return key, columns, heights, rows, {str(c): float(h) for c, h in zip(columns, safe)}
-
-
 def cmd_safe_height(args) -> int:
     from fruitimpact.handling.heights import safe_height
 
@@ -129,7 +87,11 @@ def cmd_safe_height(args) -> int:
         args.map = "surface"
     report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
     if args.map:
-        key, columns, heights, rows, safe = _risk_map(kwargs, args.map)
+        from fruitimpact.handling.heights import risk_map
+
+        # the map spans every value of its axis; the given one is the safe height's above
+        risk = _library_call(risk_map, by=args.map, **{k: v for k, v in kwargs.items() if k != args.map})
+        key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows", "safe_height"))
         report["risk_map"] = {"by": key, "safe_height": safe}
         if args.map_csv:
             from fruitimpact.impact.outputs import atomic_write
@@ -174,61 +136,23 @@ def cmd_safe_height(args) -> int:
 
 # ------------------------------------------------------------------------------------------------ line
 def cmd_line(args) -> int:
-    from fruitimpact import runs
-    from fruitimpact.handling.line import audit, read_line
-    from fruitimpact.impact.distributions import parse_distribution
     from fruitimpact.cli.runs import _count
+    from fruitimpact.handling.line import MAX_LINE_FRUIT, audit_line, read_line
 
     try:
         points = read_line(args.line)
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
-    criterion = args.criterion
-    if criterion == "none":
-        raise UsageError("argument --criterion: a line audit needs one: pressure, shear or energy (the onset "
-                         "height changes by an order of magnitude between them)")
-    from fruitimpact.impact.presets import fruit_criterion
-
-    # none given: the one the literature supports for the --fruit (issue 14 item 5c)
-    criterion = _library_call(fruit_criterion, getattr(args, "fruit", None), criterion)
     _check_outputs([("--plot", args.plot, "figure")])
-    rows = _count("-n/--rows", args.rows, 1, 10_000_000)
+    rows = _count("-n/--rows", args.rows, 1, MAX_LINE_FRUIT)
     seed = _count("--seed", args.seed, 0)
-    distributions, constants = [], {}
-    for quantity in INPUTS.values():
-        spec = getattr(args, quantity.name, None)
-        if spec is None or quantity.name in ("criterion",):
-            continue
-        if quantity.name in ("velocity", "drop_height", "surface"):
-            raise UsageError(f"argument {quantity.option}: set by each transfer point of the line")
-        if not quantity.numeric:
-            constants[quantity.name] = spec
-            continue
-        try:
-            distributions.append((quantity.name, parse_distribution(spec, quantity.dimension, quantity.name)))
-        except ValueError as exc:
-            raise UsageError(f"argument {quantity.option}: {exc}") from None
-    from fruitimpact.cli.runs import _check_text
-
-    for name, value in constants.items():
-        if name in REGISTRY_INPUTS:
-            _check_text(name, [value])
-    spreads, density, spread_lines = lot_distributions(args, constants.get("fruit"), [n for n, _ in distributions],
-                                                       criterion)
-    distributions += list(spreads)
-    source = runs.PopulationSource(tuple(distributions), (), rows, seed, density)
-    members, _ = source.inputs(0, rows, None)
-    members.pop("model", None)
-    alternatives = () if args.alternatives.strip().lower() == "none" else \
-        tuple(a.strip() for a in args.alternatives.split(","))
-    if any(not a for a in alternatives):
-        raise UsageError(f"argument --alternatives: give library surface names, comma-separated, or none; got "
-                         f"{args.alternatives!r}")
-    report = _library_call(audit, points, members, rows, criterion, constants, alternatives)
+    given = {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
+             if getattr(args, quantity.name, None) is not None}
+    report = _library_call(audit_line, points, rows=rows, seed=seed, spreads=not args.no_spreads,
+                           alternatives=args.alternatives, **given)
+    criterion = report["criterion"]
+    spread_lines = report["spreads"]
     _print_warnings("line", report["warnings"])
-    report["seed"] = seed
-    report["inputs"] = {name: dist.describe() for name, dist in distributions}
-    report["spreads"] = list(spread_lines)
     if not args.json:
         print_spreads("line", spread_lines)
     if args.plot:

@@ -12,17 +12,10 @@ from fruitimpact.impact.units import parse_quantity
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
-    if text is None:
-        return None
-    try:
-        value = parse_quantity(text, dimension)
-    except ValueError as exc:
-        raise UsageError(f"argument {option}: {exc}") from None
-    ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
-    if not ok:
-        bracket = "[" if low_inclusive else "("
-        raise UsageError(f"argument {option}: must be a number in {bracket}{low:g}, {high:g}]; got {text!r}")
-    return value
+    """``signals.options._number`` with its error as the CLI's one line."""
+    from fruitimpact.signals.options import _number
+
+    return _library_call(_number, option, text, dimension, low, low_inclusive, high)
 
 
 def _json_line(obj) -> str:
@@ -57,84 +50,12 @@ def add_analysis_options(parser) -> None:
     sort.add_argument("--classes", metavar="NAMES", help="class names, softest first (default soft,medium,firm,...)")
 
 
-#: The CLI option of each detector and analysis setting, so that their errors name what the user typed.
-_SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hum", "hum_q": "--hum",
-                    "lowpass_cutoff": "--lowpass", "clip_low": "--clip", "clip_high": "--clip",
-                    "max_flight": "--rebound-window", "pitch": "--pitch/--fruit-rate"}
-
-
-def _setting_error(exc: ValueError) -> UsageError:
-    """The library's error about a setting, prefixed with the option the user gave it by."""
-    text = str(exc)
-    option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
-    return UsageError(f"argument {option}: {text}" if option else text)
-
-
 def analysis_from(args, rate: float, rate_known: bool = True):
-    """(DetectorSettings, Analysis) from the options, every value checked before any work (those that depend
-    on the sample rate only when ``rate_known``)."""
-    from fruitimpact.physics.constants import STANDARD_GRAVITY
-    from fruitimpact.signals.analysis import Analysis
-    from fruitimpact.signals.detect import Detector, DetectorSettings
-    from fruitimpact.signals.sort import FirmnessClasses
+    """(DetectorSettings, Analysis) from the options: ``signals.options.analysis_settings``, the one check."""
+    from fruitimpact.signals.options import ANALYSIS_OPTIONS, analysis_settings
 
-    hum = _float("--hum", args.hum, "frequency")
-    lowpass = _float("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
-    clip = (None, None)
-    if args.clip:
-        try:
-            low, high = (float(parse_quantity(v, "force")) for v in args.clip.split(","))
-        except ValueError:
-            raise UsageError(f"argument --clip: expected LOW,HIGH in N; got {args.clip!r}") from None
-        if not low < high:
-            raise UsageError(f"argument --clip: LOW must be below HIGH; got {args.clip!r}")
-        clip = (low, high)
-    velocity = _float("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop
-    height = _float("--drop-height", args.drop_height, "length", high=10.0)
-    if velocity is not None and height is not None:
-        raise UsageError("give either --velocity or --drop-height, not both")
-    if height is not None:
-        velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
-    window = _float("--rebound-window", args.rebound_window, "time", low_inclusive=True, high=10.0)
-    pitch = _float("--pitch", args.pitch, "time", low=1e-3, low_inclusive=True, high=60.0)
-    fruit_rate = _float("--fruit-rate", args.fruit_rate, "frequency", high=1000.0)
-    if pitch is not None and fruit_rate is not None:
-        raise UsageError("give either --pitch or --fruit-rate, not both")
-    if fruit_rate is not None:
-        pitch = 1.0 / fruit_rate
-    try:
-        settings = DetectorSettings(
-            k_on=_float("--k-on", args.k_on, "dimensionless"), k_off=_float("--k-off", args.k_off, "dimensionless"),
-            hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
-            clip_low=clip[0], clip_high=clip[1])
-        if rate_known:
-            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
-    except ValueError as exc:
-        raise _setting_error(exc) from None
-    mass = _float("--mass", args.mass, "mass")
-    diameter = _float("--diameter", args.diameter, "length")
-    poisson = _float("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
-    classes = None
-    if args.sort_by or args.thresholds:
-        if not (args.sort_by and args.thresholds):
-            raise UsageError("argument --thresholds: give --sort-by INDEX and --thresholds A,B,... together")
-        try:
-            thresholds = tuple(float(v) for v in args.thresholds.split(","))
-        except ValueError:
-            raise UsageError(f"argument --thresholds: expected numbers A,B,...; got {args.thresholds!r}") from None
-        names = tuple(args.classes.split(",")) if args.classes else \
-            (("soft", "medium", "firm", "very-firm", "hard", "very-hard")[:len(thresholds) + 1]
-             if len(thresholds) < 6 else tuple(f"class{k}" for k in range(len(thresholds) + 1)))
-        try:
-            classes = FirmnessClasses(args.sort_by, thresholds, names)
-        except ValueError as exc:
-            raise UsageError(f"argument --sort-by/--thresholds: {exc}") from None
-    try:
-        analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,
-                            poisson=poisson, classes=classes, max_flight=window, pitch=pitch)
-    except ValueError as exc:
-        raise _setting_error(exc) from None
-    return settings, analysis
+    options = {name: getattr(args, name, None) for name in ANALYSIS_OPTIONS}
+    return _library_call(analysis_settings, rate, rate_known, **options)
 
 
 # ------------------------------------------------------------------------------------------- analyze

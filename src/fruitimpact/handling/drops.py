@@ -84,6 +84,26 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         ``total_absorbed_energy``, ``total_plastic_work``, ``total_viscous_work``,
         ``bruised`` (any impact), ``bruise_volume`` (accumulated), ``rest_time``,
         ``status`` and ``message``, ``warnings``.
+
+    Raises
+    ------
+    ValueError
+        An input outside its range or unknown, ``velocity`` given (the drop sets it), ``bounces`` not one of
+        ``BOUNCE_RULES``, ``max_impacts`` outside [1, 1000], a stress criterion for a fruit with no failure
+        stress; the message names the argument.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> report = fi.drop("30cm", fruit="apple", surface="steel")
+    >>> [round(i["restitution"], 2) for i in report["impacts"][:3]]
+    [0.55, 0.69, 0.77]
+
+    References
+    ----------
+    Each impact is :func:`fruitimpact.simulate`'s (founding paper, "Theoretical aspects about simulating the
+    reaction to impact of apples on rigid plane surfaces"); plastic reloading after C. Thornton, J. Appl. Mech.
+    64 (1997) 383–386; bounce rule: docs/damage.md.
     """
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns

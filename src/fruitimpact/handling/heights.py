@@ -108,6 +108,24 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
         ``safe_height`` [m] (0: bruises from any height; inf: none up to 10 m),
         ``safe_velocity`` [m/s], ``criterion``, ``message``, ``sensitivity`` (name →
         elasticity), and the bruise figures at that height.
+
+    Raises
+    ------
+    ValueError
+        An input outside its range or unknown, ``velocity`` or ``drop_height`` given, ``criterion`` ``none``
+        or a fruit whose library entry names no criterion when none is given; the message names the argument.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> report = fi.safe_height(fruit="apple", surface="steel", criterion="shear")
+    >>> round(report["safe_height"] * 100, 1)  # [cm]
+    3.3
+
+    References
+    ----------
+    Onset of bruising under the Hertz contact: K. L. Johnson, *Contact Mechanics* (1985) eq 3.45 and §11.4;
+    the shear criterion after Yuwana & Duprat (1998); docs/bruise.md.
     """
     from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.validation import InputError
@@ -173,3 +191,78 @@ def _check_row(given: dict) -> None:
 
 
 __all__ = ["HIGHEST", "LOWEST", "SENSITIVITY_INPUTS", "safe_height", "safe_heights"]
+
+
+#: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
+MAP_HEIGHTS = 30
+#: Moduli of a firmness map [Pa].
+MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
+#: What a risk map can run across.
+MAP_AXES = ("surface", "modulus")
+
+
+def risk_map(*, by: str = "surface", **inputs) -> dict:
+    """A bruise-risk map: drop height × library surface, or drop height × fruit modulus, with the safe
+    height of each column, from one evaluation of the whole grid and one root search.
+
+    Parameters
+    ----------
+    by : str
+        ``"surface"`` (every library surface but the rigid plane) or ``"modulus"`` (``MAP_MODULI``, 1–10 MPa).
+    **inputs
+        As for :func:`safe_height` (fruit, model, criterion, …; not the velocity, drop height or the
+        mapped input).
+
+    Returns
+    -------
+    dict
+        ``by``, ``columns`` (surface names or moduli [Pa]), ``heights`` (``MAP_HEIGHTS`` drop heights
+        [m], 5 mm to 2 m, log-spaced), ``rows`` (one dict per grid point: the mapped value,
+        ``drop_height``, ``bruise_margin``, ``bruised``, ``bruise_volume`` [m³], ``peak_force`` [N],
+        ``status``) and ``safe_height`` (column → safe height [m]).
+
+    Raises
+    ------
+    ValueError
+        An unknown axis or input, or an input outside its range (the message names it).
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> risk = fi.risk_map(by="surface", fruit="apple", criterion="shear")
+    >>> sorted(risk["safe_height"])[:2]  # doctest: +SKIP
+
+    References
+    ----------
+    As :func:`safe_height`.
+    """
+    import numpy as np
+
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.impact.registries import SURFACE_CHOICES
+    from fruitimpact.impact.validation import InputError
+
+    if by not in MAP_AXES:
+        raise InputError(f"by must be one of {', '.join(MAP_AXES)}; got {by!r}", "map")
+    for name in ("velocity", "drop_height", by):
+        if inputs.get(name) is not None:
+            raise InputError(f"{name} is set by the risk map: leave it out", name)
+    heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
+    columns = [name for name in SURFACE_CHOICES if name != "rigid"] if by == "surface" else list(MAP_MODULI)
+    base = {name: value for name, value in inputs.items() if value is not None}
+    n = len(columns) * heights.size
+    table = {name: [value] * n for name, value in base.items()}
+    table[by] = [c for c in columns for _ in heights]
+    table["drop_height"] = [h for _ in columns for h in heights]
+    result = evaluation(table)
+    rows = [{by: table[by][i], "drop_height": table["drop_height"][i],
+             "bruise_margin": float(result.columns["bruise_margin"][i]),
+             "bruised": float(result.columns["bruised"][i]),
+             "bruise_volume": float(result.columns["bruise_volume"][i]),
+             "peak_force": float(result.columns["peak_force"][i]),
+             "status": "ok" if result.status[i] == 0 else result.messages.text(i)} for i in range(n)]
+    safe_table = {name: [value] * len(columns) for name, value in base.items()}
+    safe_table[by] = columns
+    safe, _ = safe_heights(safe_table, len(columns))
+    return {"by": by, "columns": columns, "heights": heights, "rows": rows,
+            "safe_height": {str(c): float(h) for c, h in zip(columns, safe)}}

@@ -669,6 +669,23 @@ def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.Da
         law (``law_stiffness`` [N/m^1.5, N/m for Kelvin–Voigt], ``damping``,
         ``damping_factor``), the characteristics, and categorical ``status``
         (ok, inaccurate, failed, invalid), ``message`` and ``warnings``.
+
+    Raises
+    ------
+    ValueError
+        An unknown or misspelt column, a column of the wrong length; a bad value in a row makes that row
+        ``invalid`` with its message instead (a batch never dies on one bad row).
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> table = fi.evaluate({"drop_height": ["2cm", "10cm", "-1"], "fruit": "apple"})
+    >>> table["status"].tolist()
+    ['ok', 'ok', 'invalid']
+
+    References
+    ----------
+    As :func:`fruitimpact.simulate`, row by row.
     """
     return evaluation(table, tabulated=tabulated, errors=errors).frame()
 

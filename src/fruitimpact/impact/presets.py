@@ -252,3 +252,20 @@ def effective_mass(mass, partner_mass):
 __all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
            "lot_spreads", "resolve"]
 assert all(name in INPUTS for name in DAMAGE_DEFAULTS) and math.isfinite(DAMAGE_DEFAULTS["failure_stress"])
+
+
+def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: bool = True):
+    """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
+    (the default fruit when None): the library spreads (``lot_spreads``) of the inputs not in ``given``,
+    the bruise inputs only with a ``criterion`` (issue 14 item 4); none when ``spreads`` is False (identical
+    fruit at the library values).  ValueError naming ``fruit`` for a fruit that is not in the library."""
+    fruit = fruit or INPUTS["fruit"].default
+    if not spreads:
+        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",)
+    from fruitimpact.impact.validation import InputError
+
+    try:
+        lot = lot_spreads(fruit, given, bruise=criterion not in (None, "none"))
+    except ValueError as exc:
+        raise InputError(str(exc), "fruit") from None
+    return lot.distributions, lot.diameter_density, lot.described

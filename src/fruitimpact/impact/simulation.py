@@ -429,6 +429,25 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
         ``status`` is not ok (with a message saying what and by how much) when the
         solver failed or missed its accuracy; inputs out of range raise ``ValueError``
         (an ``InputError`` naming the argument) instead.
+
+    Raises
+    ------
+    ValueError
+        An input outside its allowed range, unknown, or NaN; conflicting inputs (``velocity`` and
+        ``drop_height``); the message names the argument and its allowed range.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> result = fi.simulate()  # the founding paper's Jonathan apple at 1 m/s
+    >>> result.status, round(result.characteristics.restitution, 3)
+    ('ok', 0.577)
+
+    References
+    ----------
+    "Theoretical aspects about simulating the reaction to impact of apples on rigid plane surfaces" (the
+    nonlinear Kelvin–Voigt model, eqs 7–12, and its worked example, section 3); H. Hertz (1882);
+    K. H. Hunt, F. R. E. Crossley, J. Appl. Mech. 42 (1975) 440–445.
     """
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns

@@ -11,7 +11,7 @@ from fruitimpact.plotting._backend import _pyplot
 
 def risk_map_figure(key: str, columns, heights, rows, safe: dict, criterion: str):
     """Bruise margin over drop height (x, log) and surface or modulus (y), with each column's safe
-    height marked; ``rows`` as from ``cli.damage._risk_map`` (column-major: all heights of the first
+    height marked; ``rows`` as from ``handling.heights.risk_map`` (column-major: all heights of the first
     column first)."""
     plt = _pyplot()
     margin = np.array([row["bruise_margin"] for row in rows], dtype=float).reshape(len(columns), len(heights))

@@ -9,12 +9,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fruitimpact.impact.lots import BLOCK_ROWS  # noqa: F401 (a limit of a run, defined with the lot)
 from fruitimpact.impact.quantities import CHARACTERISTICS, Quantity
 
 #: Rows per chunk by default: large enough that the per-chunk overhead is small next to evaluation.
 CHUNK_ROWS = 500_000
-#: Rows per block of a population's random streams (a member's inputs depend only on seed and row).
-BLOCK_ROWS = 65_536
 #: Target size of the uniform sample kept for percentiles; populations up to this size are exact.
 SAMPLE_ROWS = 2_000_000
 #: Default percentiles reported for populations [%].

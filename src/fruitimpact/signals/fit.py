@@ -553,6 +553,19 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
         NaN or infinite samples (in force, where the mask uses them); times not increasing;
         a non-positive velocity, mass, diameter or noise; ``diameter`` without ``poisson`` or
         the reverse; ``poisson`` outside [0, 0.5).
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> result = fi.simulate(drop_height="4cm")
+    >>> fit = fi.fit_impact(result.curves.time, result.curves.force, velocity=result.inputs.velocity)
+    >>> round(fit["restitution"], 3)  # doctest: +SKIP
+    0.577
+
+    References
+    ----------
+    The Hunt–Crossley force law of "Theoretical aspects about simulating the reaction to impact of apples on
+    rigid plane surfaces" (eqs 10–12); K. H. Hunt, F. R. E. Crossley, J. Appl. Mech. 42 (1975) 440–445.
     """
     if velocity is None and mass is None:
         raise ValueError("fit_impact needs the impact velocity (velocity=, from the drop height) or the "

@@ -60,7 +60,44 @@ class FirmnessClasses:
 def calibrate(values, labels, classes, by: str) -> FirmnessClasses:
     """Thresholds of ``by`` that best separate the reference fruit: ``values`` of the index, their known
     ``labels``, and ``classes`` the class names from the softest to the firmest.  Maximises the balanced
-    accuracy exactly (dynamic programming over the sorted values)."""
+    accuracy exactly (dynamic programming over the sorted values).
+
+    Parameters
+    ----------
+    values : array of float
+        The index ``by`` of each reference fruit [SI: N/s for C, N/s² for C*, Pa for the modulus …].
+    labels : array of str
+        The known class of each reference fruit (one of ``classes``).
+    classes : sequence of str
+        The class names, softest first.
+    by : str
+        The index: one of ``SORT_INDICES`` (``firmness_c``, ``firmness_c_star``, ``modulus``, ``stiffness``,
+        ``peak_force``).
+
+    Returns
+    -------
+    FirmnessClasses
+        ``by``, the ascending ``thresholds`` and the ``classes``; ``classify(values)`` sorts new fruit.
+
+    Raises
+    ------
+    ValueError
+        Values and labels of different lengths, a value that is not finite, a label not among ``classes``,
+        fewer than two classes.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> classes = fi.calibrate_classes([1e5, 2e5, 5e5, 6e5], ["soft", "soft", "firm", "firm"], ("soft", "firm"),
+    ...                                "firmness_c_star")
+    >>> classes.classify([1.5e5, 5.5e5]).tolist()
+    ['soft', 'firm']
+
+    References
+    ----------
+    The indices C and C*: eqs 1–2 of "Theoretical aspects about simulating the reaction to impact of apples on
+    rigid plane surfaces"; the balanced accuracy: Brodersen et al., ICPR 2010.
+    """
     values = np.asarray(values, dtype=float)
     labels = np.asarray(labels, dtype=object)
     classes = tuple(classes)

@@ -184,6 +184,35 @@ def read_recording(path, *, rate: float | None = None, column: str | None = None
     Raises ``ValueError`` (one line) as ``open_recording`` and its ``chunks``
     do.  Memory: the recording itself, two (three for CSV) times over while it is
     built; use ``open_recording(...).chunks()`` for files larger than memory.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (``.csv``/``.txt``, ``.npy``, ``.f32``/``.bin``/``.raw``, ``.tdms``).
+    rate, column, format, lanes
+        As for :func:`open_recording` (``rate`` [Hz]).
+
+    Returns
+    -------
+    Recording
+        Force [N] of each lane at ``rate`` [Hz], with its ``start_time`` [s] and clip limits when known.
+
+    Raises
+    ------
+    ValueError
+        A file that cannot be read or is not a recording (a ragged row, a non-finite sample, no unit on the
+        time column), an unsupported format, a rate that is missing or disagrees with the file; the message
+        names the row or column.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> recording = fi.read_recording("line.tdms")  # doctest: +SKIP
+    >>> recording.rate, list(recording.lanes)  # doctest: +SKIP
+
+    References
+    ----------
+    TDMS: NI's TDMS file format (read with nptdms); the other formats: docs/signals.md.
     """
     source = open_recording(path, rate=rate, column=column, format=format, lanes=lanes)
     if source.samples is not None:  # lane by lane from the start: each lane one contiguous array

@@ -1,0 +1,103 @@
+"""A whole recording analysed at once: a file or an array of force samples → one row per impact.
+
+The samples go through the streaming detector and analysis (:class:`~fruitimpact.signals.stream.StreamAnalyzer`)
+in chunks, exactly as ``fruitimpact analyze`` does, so the rows are those of ``analyze --json`` and memory is
+bounded by the chunk, not the recording.
+"""
+
+from __future__ import annotations
+
+#: Samples per lane read and analysed at once (memory is bounded by this, not by the recording).
+ANALYZE_CHUNK = 1 << 18
+
+
+def analyze(source, *, rate=None, column: str | None = None, format: str | None = None, lanes: int = 1,
+            **options):
+    """Detect and analyse every impact of a force recording.
+
+    Parameters
+    ----------
+    source : str, path, array or Recording
+        A recording file (``.csv``/``.txt``, ``.npy``, ``.f32``/``.bin``/``.raw``, ``.tdms``), an array of force
+        samples [N] of shape (n,) or (n, lanes) (then ``rate`` is required), or a
+        :class:`~fruitimpact.signals.recording.Recording`.
+    rate : float or str, optional
+        Sample rate [Hz]; required for arrays, ``.npy`` and raw files and CSV files without a time column.
+    column : str, optional
+        Analyse only this lane of a file.
+    format : str, optional
+        ``csv``, ``npy``, ``f32`` or ``tdms`` (default: from the extension).
+    lanes : int
+        Interleaved lanes of a raw float32 file.
+    **options
+        The analysis options of ``fruitimpact analyze`` by their Python names
+        (:data:`fruitimpact.signals.options.ANALYSIS_OPTIONS`): ``hum`` [Hz], ``lowpass`` [Hz], ``k_on``, ``k_off``,
+        ``clip`` (``"LOW,HIGH"`` [N]), ``rebound_window`` [s], ``pitch`` [s] or ``fruit_rate`` [Hz], ``fit`` (bool),
+        ``velocity`` [m/s] or ``drop_height`` [m], ``mass`` [kg], ``diameter`` [m], ``poisson``, ``sort_by``,
+        ``thresholds`` (``"A,B"``), ``classes`` (``"soft,firm,…"``).  Numbers [SI] or strings with units.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per contact in time order per lane, with the columns of ``fruitimpact analyze --json``
+        (``lane``, ``start_time`` [s], ``peak_force`` [N], ``time_to_peak`` [s], ``contact_duration`` [s],
+        ``firmness_c`` [N/s], ``firmness_c_star`` [N/s²], ``status``, ``rebound_of`` …; with ``fit`` the fitted
+        stiffness, restitution and, with a velocity or mass, the modulus).
+
+    Raises
+    ------
+    ValueError
+        An unreadable file, a rate that is missing or disagrees with the file, an unknown option or a value out
+        of range; the message names the option as the CLI spells it.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> impacts = fi.analyze("line.csv", fit=True, drop_height="4cm", hum="50Hz")  # doctest: +SKIP
+    >>> impacts[["lane", "peak_force", "firmness_c_star", "restitution"]]  # doctest: +SKIP
+
+    References
+    ----------
+    The firmness indices C = F_max/t_c and C* = F_max/t_c² are eqs 1–2 of "Theoretical aspects about simulating
+    the reaction to impact of apples on rigid plane surfaces"; the fitted force law is its Hunt–Crossley model.
+    """
+    import numpy as np
+    import pandas as pd
+
+    from fruitimpact.impact.validation import InputError, check_integer
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.options import _number, analysis_settings
+    from fruitimpact.signals.read import open_recording
+    from fruitimpact.signals.recording import Recording
+    from fruitimpact.signals.stream import StreamAnalyzer
+
+    lanes = check_integer("lanes", lanes, 1)
+    rate_value = None if rate is None else _number("--rate", rate, "frequency")
+    analysis_settings(rate_value if rate_value is not None else 1e12, rate_value is not None, **options)
+    if isinstance(source, Recording):
+        names, start, chunks, rate_value = list(source.lanes), source.start_time, None, source.rate
+        samples = np.column_stack([source.lanes[name] for name in names])
+    elif isinstance(source, (str, bytes)) or hasattr(source, "__fspath__"):
+        reader = open_recording(source, rate=rate_value, column=column, format=format, lanes=lanes)
+        names, start, rate_value, samples = list(reader.lane_names), reader.start_time, reader.rate, None
+        chunks = reader.chunks(ANALYZE_CHUNK)
+    else:
+        if rate_value is None:
+            raise InputError("argument --rate: required for an array of samples (the sample rate [Hz])", "rate")
+        samples = np.asarray(source, dtype=float)
+        if samples.ndim == 1:
+            samples = samples[:, None]
+        if samples.ndim != 2 or samples.shape[0] == 0:
+            raise InputError(f"source must be force samples of shape (n,) or (n, lanes); got shape {samples.shape}")
+        names, start, chunks = [f"lane{k}" for k in range(samples.shape[1])], 0.0, None
+    if chunks is None:
+        chunks = (samples[i:i + ANALYZE_CHUNK] for i in range(0, samples.shape[0], ANALYZE_CHUNK))
+    settings, analysis = analysis_settings(rate_value, True, **options)
+    rows = []
+    analyzer = StreamAnalyzer(rate_value, len(names), settings, lambda report: None,
+                              on_detected=lambda impact, report: rows.append(public(report)), analysis=analysis,
+                              lane_names=names, start_time=start)
+    for chunk in chunks:
+        analyzer.feed(chunk)
+    analyzer.close()
+    return pd.DataFrame(rows)

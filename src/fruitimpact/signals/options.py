@@ -1,0 +1,130 @@
+"""The options of a recording's analysis, checked in one place for the CLI (``analyze``, ``stream``) and the
+Python API (:func:`fruitimpact.analyze`): detection (hum, low-pass, thresholds, clip limits), rebounds
+(window, feed pitch), the fit (velocity or drop height, mass, diameter, Poisson's ratio) and firmness
+classes.  Values are numbers [SI] or strings with units (``"50Hz"``, ``"4cm"``); every error is one
+``ValueError`` line naming the option as the CLI spells it."""
+
+from __future__ import annotations
+
+import math
+
+from fruitimpact.impact.units import parse_quantity
+from fruitimpact.impact.validation import InputError
+
+#: The analysis options (Python name → CLI option), with their defaults as the CLI gives them.
+ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "rebound_window": "--rebound-window", "pitch": "--pitch",
+                    "fruit_rate": "--fruit-rate", "k_on": "--k-on", "k_off": "--k-off", "clip": "--clip",
+                    "fit": "--fit", "drop_height": "--drop-height", "velocity": "--velocity", "mass": "--mass",
+                    "diameter": "--diameter", "poisson": "--poisson", "sort_by": "--sort-by",
+                    "thresholds": "--thresholds", "classes": "--classes"}
+ANALYSIS_DEFAULTS = {"k_on": "6", "k_off": "3", "fit": False}
+
+
+def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
+    if text is None:
+        return None
+    try:
+        value = parse_quantity(text, dimension)
+    except ValueError as exc:
+        raise InputError(f"argument {option}: {exc}") from None
+    ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
+    if not ok:
+        bracket = "[" if low_inclusive else "("
+        raise InputError(f"argument {option}: must be a number in {bracket}{low:g}, {high:g}]; got {text!r}")
+    return value
+
+
+#: The CLI option of each detector and analysis setting, so that their errors name what the user typed.
+_SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hum", "hum_q": "--hum",
+                    "lowpass_cutoff": "--lowpass", "clip_low": "--clip", "clip_high": "--clip",
+                    "max_flight": "--rebound-window", "pitch": "--pitch/--fruit-rate"}
+
+
+def _setting_error(exc: ValueError) -> InputError:
+    """The library's error about a setting, prefixed with the option the user gave it by."""
+    text = str(exc)
+    option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
+    return InputError(f"argument {option}: {text}" if option else text)
+
+
+def analysis_settings(rate: float, rate_known: bool = True, **options):
+    """(DetectorSettings, Analysis) from the analysis ``options`` (``ANALYSIS_OPTIONS``; numbers [SI] or
+    strings with units), every value checked before any work (those that depend on the sample rate only
+    when ``rate_known``).  ValueError naming the option for an unknown option or a value out of range."""
+    unknown = [name for name in options if name not in ANALYSIS_OPTIONS]
+    if unknown:
+        raise InputError(f"unknown analysis option {unknown[0]!r} (options: {', '.join(ANALYSIS_OPTIONS)})")
+    args = _Options({**ANALYSIS_DEFAULTS, **{k: v for k, v in options.items() if v is not None}})
+    from fruitimpact.physics.constants import STANDARD_GRAVITY
+    from fruitimpact.signals.analysis import Analysis
+    from fruitimpact.signals.detect import Detector, DetectorSettings
+    from fruitimpact.signals.sort import FirmnessClasses
+
+    hum = _number("--hum", args.hum, "frequency")
+    lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
+    clip = (None, None)
+    if args.clip:
+        try:
+            low, high = (float(parse_quantity(v, "force")) for v in args.clip.split(","))
+        except ValueError:
+            raise InputError(f"argument --clip: expected LOW,HIGH in N; got {args.clip!r}") from None
+        if not low < high:
+            raise InputError(f"argument --clip: LOW must be below HIGH; got {args.clip!r}")
+        clip = (low, high)
+    velocity = _number("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop
+    height = _number("--drop-height", args.drop_height, "length", high=10.0)
+    if velocity is not None and height is not None:
+        raise InputError("give either --velocity or --drop-height, not both")
+    if height is not None:
+        velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
+    window = _number("--rebound-window", args.rebound_window, "time", low_inclusive=True, high=10.0)
+    pitch = _number("--pitch", args.pitch, "time", low=1e-3, low_inclusive=True, high=60.0)
+    fruit_rate = _number("--fruit-rate", args.fruit_rate, "frequency", high=1000.0)
+    if pitch is not None and fruit_rate is not None:
+        raise InputError("give either --pitch or --fruit-rate, not both")
+    if fruit_rate is not None:
+        pitch = 1.0 / fruit_rate
+    try:
+        settings = DetectorSettings(
+            k_on=_number("--k-on", args.k_on, "dimensionless"), k_off=_number("--k-off", args.k_off, "dimensionless"),
+            hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
+            clip_low=clip[0], clip_high=clip[1])
+        if rate_known:
+            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
+    except ValueError as exc:
+        raise _setting_error(exc) from None
+    mass = _number("--mass", args.mass, "mass")
+    diameter = _number("--diameter", args.diameter, "length")
+    poisson = _number("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
+    classes = None
+    if args.sort_by or args.thresholds:
+        if not (args.sort_by and args.thresholds):
+            raise InputError("argument --thresholds: give --sort-by INDEX and --thresholds A,B,... together")
+        try:
+            thresholds = tuple(float(v) for v in args.thresholds.split(","))
+        except ValueError:
+            raise InputError(f"argument --thresholds: expected numbers A,B,...; got {args.thresholds!r}") from None
+        names = tuple(args.classes.split(",")) if args.classes else \
+            (("soft", "medium", "firm", "very-firm", "hard", "very-hard")[:len(thresholds) + 1]
+             if len(thresholds) < 6 else tuple(f"class{k}" for k in range(len(thresholds) + 1)))
+        try:
+            classes = FirmnessClasses(args.sort_by, thresholds, names)
+        except ValueError as exc:
+            raise InputError(f"argument --sort-by/--thresholds: {exc}") from None
+    try:
+        analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,
+                            poisson=poisson, classes=classes, max_flight=window, pitch=pitch)
+    except ValueError as exc:
+        raise _setting_error(exc) from None
+    return settings, analysis
+
+
+
+
+class _Options(dict):
+    """The options as attributes (None when not given)."""
+
+    def __getattr__(self, name):
+        if name not in ANALYSIS_OPTIONS:
+            raise AttributeError(name)
+        return self.get(name)

@@ -1,0 +1,158 @@
+"""The Python API (issue 15 item 2): a documented top-level function for every task, each agreeing with its
+CLI command on one case (the same validation and the same numbers: one path), with its examples executed."""
+
+from __future__ import annotations
+
+import doctest
+import inspect
+import json
+import math
+
+import numpy as np
+import pytest
+
+import fruitimpact as fi
+
+#: The task functions and what a reader needs in their docstrings (numpy style).
+TASKS = ("simulate", "evaluate", "drop", "safe_height", "risk_map", "audit_line", "analyze", "read_recording",
+         "fit_impact", "calibrate_classes")
+SECTIONS = ("Parameters", "Returns", "Raises", "Examples", "References")
+
+
+@pytest.mark.parametrize("name", TASKS)
+def test_every_task_function_has_a_full_docstring(name):
+    doc = inspect.getdoc(getattr(fi, name))
+    missing = [s for s in SECTIONS if f"{s}\n---" not in doc]
+    assert not missing, f"fi.{name} lacks {missing}"
+    assert "[" in doc, f"fi.{name} gives no unit in brackets"
+
+
+@pytest.mark.parametrize("name", TASKS)
+def test_the_examples_run(name):
+    """The docstring examples are executed (those that need a file of the user's are marked SKIP)."""
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    for test in doctest.DocTestFinder(recurse=False).find(getattr(fi, name), name, globs={}):
+        runner.run(test)
+    assert runner.summarize(verbose=False).failed == 0
+
+
+def test_every_public_name_resolves():
+    for name in fi.__all__:
+        assert getattr(fi, name) is not None, name
+
+
+# ----------------------------------------------------------------------------- each command and its function
+def test_simulate_agrees_with_the_cli(cli):
+    report = cli.json("simulate", "--fruit", "apple", "--drop-height", "20cm", "--surface", "wood")
+    result = fi.simulate(fruit="apple", drop_height="20cm", surface="wood")
+    assert report["peak_force"] == pytest.approx(result.characteristics.peak_force, rel=1e-12)
+    assert report["status"] == result.status
+
+
+def test_drop_agrees_with_the_cli(cli):
+    report = cli.json("drop", "--drop-height", "30cm", "--fruit", "apple", "--surface", "steel")
+    library = fi.drop("30cm", fruit="apple", surface="steel")
+    assert report["impact_count"] == library["impact_count"]
+    assert [i["restitution"] for i in report["impacts"]] == pytest.approx(
+        [i["restitution"] for i in library["impacts"]], rel=1e-12)
+
+
+def test_safe_height_and_risk_map_agree_with_the_cli(cli):
+    report = cli.json("safe-height", "--fruit", "apple", "--surface", "steel", "--criterion", "shear",
+                      "--map", "surface")
+    library = fi.safe_height(fruit="apple", surface="steel", criterion="shear")
+    assert report["safe_height"] == pytest.approx(library["safe_height"], rel=1e-12)
+    risk = fi.risk_map(by="surface", fruit="apple", criterion="shear")
+    assert report["risk_map"]["safe_height"] == pytest.approx(risk["safe_height"], rel=1e-12)
+
+
+def test_audit_line_agrees_with_the_cli(cli):
+    report = cli.json("line", "examples/line.csv", "-n", "400", "--seed", "3", "--fruit", "apple")
+    library = fi.audit_line("examples/line.csv", rows=400, seed=3, fruit="apple")
+    assert report["incidence"] == pytest.approx(library["incidence"], rel=1e-12)
+    assert report["worst_point"] == library["worst_point"]
+    assert report["spreads"] == library["spreads"] and report["inputs"] == library["inputs"]
+
+
+def test_audit_line_refuses_what_the_cli_refuses():
+    with pytest.raises(ValueError, match="velocity is set by each transfer point"):
+        fi.audit_line("examples/line.csv", rows=10, velocity=2.0)
+    with pytest.raises(ValueError, match="rows must be an integer"):
+        fi.audit_line("examples/line.csv", rows=0)
+    with pytest.raises(ValueError, match="unknown input 'mas'"):
+        fi.audit_line("examples/line.csv", rows=10, mas=0.1)
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """A two-fruit recording made from the simulator's own pulses (a consistency case: the truth of real lines
+    is tested in test_signals_*.py against an independent generator)."""
+    rate = 20_000.0
+    force = np.zeros(int(0.4 * rate))
+    for start, height in ((0.05, "3cm"), (0.25, "6cm")):
+        curves = fi.simulate(fruit="apple", drop_height=height).curves
+        t = np.arange(0.0, curves.time[-1], 1.0 / rate)
+        i = int(start * rate)
+        force[i:i + t.size] += np.interp(t, curves.time, curves.force)
+    force += np.random.default_rng(0).normal(0.0, 0.02, force.size)
+    path = tmp_path_factory.mktemp("rec") / "two.csv"
+    np.savetxt(path, np.column_stack([np.arange(force.size) / rate, force]), delimiter=",",
+               header="time [s],force [N]", comments="")
+    return path, force, rate
+
+
+def test_analyze_agrees_with_the_cli(cli, recording):
+    path, force, rate = recording
+    status, out, err = cli.run("analyze", path, "--json", "--fit", "--drop-height", "4cm")
+    assert status == 0, err
+    lines = [json.loads(line) for line in out.splitlines() if line.strip()]
+    table = fi.analyze(path, fit=True, drop_height="4cm")
+    assert len(table) == len(lines) == 2
+    assert list(table.columns) == list(lines[0])
+    for row, line in zip(table.to_dict("records"), lines):
+        for key, value in line.items():
+            if isinstance(value, float) and math.isfinite(value):
+                assert row[key] == pytest.approx(value, rel=1e-12), key
+    from_array = fi.analyze(force, rate=rate, fit=True, drop_height="4cm")
+    assert from_array["peak_force"].tolist() == pytest.approx(table["peak_force"].tolist(), rel=1e-12)
+
+
+def test_analyze_refuses_like_the_cli(cli, recording):
+    path, force, _ = recording
+    message = cli.error("analyze", path, "--hum", "-5")
+    with pytest.raises(ValueError) as caught:
+        fi.analyze(path, hum="-5")
+    assert str(caught.value) == message.split(": error: ", 1)[1]
+    with pytest.raises(ValueError, match="--rate"):
+        fi.analyze(force)
+    with pytest.raises(ValueError, match="unknown analysis option 'hun'"):
+        fi.analyze(path, hun=50)
+
+
+def test_classes_agree_with_the_cli(cli, tmp_path):
+    rows = [(1e5, "soft"), (1.4e5, "soft"), (2e5, "soft"), (4e5, "firm"), (5e5, "firm"), (7e5, "firm")]
+    path = tmp_path / "ref.csv"
+    path.write_text("firmness_c_star,label\n" + "".join(f"{v},{c}\n" for v, c in rows))
+    report = cli.json("classes", path, "--classes", "soft,firm")
+    classes = fi.calibrate_classes([v for v, _ in rows], [c for _, c in rows], ("soft", "firm"), "firmness_c_star")
+    assert report["thresholds"] == pytest.approx(list(classes.thresholds), rel=1e-12)
+
+
+def test_fruits_and_surfaces_agree_with_the_cli(cli):
+    assert [row["name"] for row in json.loads(cli.ok("fruits", "--json"))] == list(fi.fruits())
+    assert [row["name"] for row in json.loads(cli.ok("surfaces", "--json"))] == list(fi.surfaces())
+
+
+def test_evaluate_agrees_with_batch(cli, tmp_path):
+    table = tmp_path / "in.csv"
+    table.write_text("fruit,drop_height,surface\napple,2cm,steel\npear,10cm,wood\napple,-1,steel\n")
+    out = tmp_path / "out.csv"
+    status, _, err = cli.run("batch", table, "-o", out)
+    import pandas as pd
+
+    written = pd.read_csv(out)
+    library = fi.evaluate(pd.read_csv(table, dtype=str))
+    assert written["status"].tolist() == library["status"].astype(str).tolist()
+    ok = library["status"] == "ok"
+    assert written.loc[ok.to_numpy(), "peak_force"].tolist() == pytest.approx(
+        library.loc[ok, "peak_force"].tolist(), rel=1e-12)
