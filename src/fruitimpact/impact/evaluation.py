@@ -192,6 +192,29 @@ def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> 
             warnings.add(outside[row], implausible_message(quantity, inputs.matrix[j, 0] if detail else None))
 
 
+#: Rows handed to a compiled kernel at once.  Python regains control between two slices, so a Ctrl-C
+#: stops any run within about half a second, even at the slowest kernels' ~30,000 rows/s (damped
+#: plastic contact), where one call on a 500,000-row chunk used to hold it for 16 s (issue 15 item 5).
+KERNEL_SLICE = 16_384
+
+
+def in_slices(kernel, *args):
+    """``kernel(*args)`` over slices of ``KERNEL_SLICE`` rows: every array argument whose first axis is the
+    row count is cut, the others (law, flags) are passed whole; the results (an array or a tuple of arrays,
+    one row per input row) are joined.  Rows are independent, so the result is the same as one call."""
+    rows = next(a.shape[0] for a in args if isinstance(a, np.ndarray) and a.ndim >= 1)
+    if rows <= KERNEL_SLICE:
+        return kernel(*args)
+    parts = []
+    for start in range(0, rows, KERNEL_SLICE):
+        stop = min(start + KERNEL_SLICE, rows)
+        parts.append(kernel(*(a[start:stop] if isinstance(a, np.ndarray) and a.ndim >= 1 and a.shape[0] == rows
+                              else a for a in args)))
+    if isinstance(parts[0], tuple):
+        return tuple(np.concatenate(pieces) for pieces in zip(*parts))
+    return np.concatenate(parts)
+
+
 def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: bool | None = None,
                     detail: bool = False, closed_forms: bool = False) -> Evaluation:
     """The core of ``evaluate``: validated, resolved and computed rows, all arrays.
@@ -383,21 +406,21 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             engine = crushing_characteristics if crushing[plastic_rows].all() else plastic_characteristics
             if crushing[plastic_rows].any() and not crushing[plastic_rows].all():
                 engine = _mixed_crushing(crushing[plastic_rows])
-            group[group_plastic], plastic_block[plastic_rows] = engine(
-                mass[plastic_rows], velocity[plastic_rows], stiffness[plastic_rows], radius[plastic_rows],
+            group[group_plastic], plastic_block[plastic_rows] = in_slices(
+                engine, mass[plastic_rows], velocity[plastic_rows], stiffness[plastic_rows], radius[plastic_rows],
                 contact_modulus[plastic_rows], yield_pressure[plastic_rows], layer_stiffness[plastic_rows],
                 bottoming[plastic_rows], factor[plastic_rows])
             if elastic_rows.size:
-                group[~group_plastic] = solver.batch(law, law_stiffness[elastic_rows], factor[elastic_rows],
-                                                     mass[elastic_rows], velocity[elastic_rows],
-                                                     radius[elastic_rows], step[elastic_rows], tabulated)
+                group[~group_plastic] = in_slices(solver.batch, law, law_stiffness[elastic_rows],
+                                                  factor[elastic_rows], mass[elastic_rows], velocity[elastic_rows],
+                                                  radius[elastic_rows], step[elastic_rows], tabulated)
             reference = None  # rk4 is refused for these rows
             sel = idx
         else:
             arguments = (law_stiffness[sel], factor[sel], mass[sel], velocity[sel], radius[sel], step[sel],
                          tabulated)
-            group = solver.batch(law, *arguments)
-            reference = SOLVERS["accurate"].batch(law, *arguments) if solver.checked else None
+            group = in_slices(solver.batch, law, *arguments)
+            reference = in_slices(SOLVERS["accurate"].batch, law, *arguments) if solver.checked else None
         judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference,
               time_scale=lambda some: hertz_contact_duration(mass[some], stiffness[some], velocity[some]))
         if out is None and idx.size == rows:  # one group: its array is the output (no scatter)
