@@ -391,8 +391,10 @@ def cap_volume(depth, width):
     width : float or array
         Bruise width w [m] (chord at the surface), ≥ 0.
 
-    Source: spherical-cap geometry; used for bruises by Mohsenin (1986) and Holt & Schoorl (1977)
-    (attribution as reported in the postharvest literature; note §b.2).
+    References
+    ----------
+    Spherical-cap geometry; used for bruises by Mohsenin (1986) and Holt & Schoorl (1977) (attribution as
+    reported in the postharvest literature; note §b.2).
     """
     d = _values("depth", depth, 0.0, unit="m")
     w = _values("width", width, 0.0, unit="m")

@@ -420,8 +420,7 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
         ``failure_stress`` [Pa], ``criterion`` (``pressure``, ``shear``, ``energy``),
         ``bruise_susceptibility`` [m³/J], ``bruise_energy`` [J], ``partner_mass`` [kg],
         ``surface_model``, or the fruit's ``mass``, ``diameter`` … without a Fruit.
-
-    Numbers may be given as strings with units (``velocity="2 m/s"``).
+        Numbers may be given as strings with units (``velocity="2 m/s"``).
 
     Returns
     -------
