@@ -174,12 +174,28 @@ def hertz_max_shear(poisson):
     """
     nu = _poisson(poisson)
     distinct, inverse = np.unique(nu.ravel(), return_inverse=True)
+    shear = np.full_like(distinct, np.nan)
     depth = np.full_like(distinct, np.nan)
-    finite = ~np.isnan(distinct)
-    depth[finite] = _max_shear_depth(distinct[finite])
-    sigma_z, sigma_r = hertz_axis_stresses(np.where(finite, depth, 0.0), np.where(finite, distinct, 0.0))
-    shear = np.where(finite, 0.5 * np.abs(sigma_z - sigma_r), np.nan)
+    known = [float(v) in _MAX_SHEAR for v in distinct]
+    for i in np.flatnonzero(known):
+        shear[i], depth[i] = _MAX_SHEAR[float(distinct[i])]
+    todo = ~np.asarray(known, dtype=bool) & ~np.isnan(distinct)
+    if todo.any():
+        # a value of ν always gets the same bits (each is iterated alone), so cached and fresh values agree
+        depth[todo] = _max_shear_depth(distinct[todo])
+        sigma_z, sigma_r = hertz_axis_stresses(depth[todo], distinct[todo])
+        shear[todo] = 0.5 * np.abs(sigma_z - sigma_r)
+        if len(_MAX_SHEAR) + int(todo.sum()) > _MAX_SHEAR_SIZE:
+            _MAX_SHEAR.clear()
+        for i in np.flatnonzero(todo)[:_MAX_SHEAR_SIZE]:
+            _MAX_SHEAR[float(distinct[i])] = (float(shear[i]), float(depth[i]))
     return shear[inverse].reshape(nu.shape)[()], depth[inverse].reshape(nu.shape)[()]
+
+
+#: τ_max/p0 and z/a by value of ν, computed once (a simulate() call, a drop or a line point has one or a few
+#: values of ν; the root search took a third of one simulate()).  Bounded: cleared when full.
+_MAX_SHEAR: dict[float, tuple[float, float]] = {}
+_MAX_SHEAR_SIZE = 4096
 
 
 def shear_onset_pressure_factor(poisson):
