@@ -2,7 +2,8 @@
 
     python benchmarks/run.py [--quick] [--markdown FILE]
 
-It also runs the signal-path benchmarks (signals.py, signals_fit.py, scorecard.py, latency.py and
+It also runs interactive.py (per-call latency, start-up) and the signal-path benchmarks (signals.py,
+signals_fit.py, scorecard.py, latency.py and
 analyze_memory.py --quick), which print their own tables; the one-hour memory run of analyze_memory.py is a
 command of its own (37 min).
 
@@ -333,7 +334,8 @@ def main(argv=None):
     # the signal-path benchmarks print their own tables (each figure beside its baseline or goal in the same run);
     # --quick runs their small sizes; the 1 h memory run is `python benchmarks/analyze_memory.py` (37 min) alone
     here = Path(__file__).parent
-    for script, options in (("signals.py", ["--quick"] if args.quick else []),
+    for script, options in (("interactive.py", []),
+                            ("signals.py", ["--quick"] if args.quick else []),
                             ("signals_fit.py", []),
                             ("scorecard.py", ["--quick"] if args.quick else []),
                             ("latency.py", ["--quick"] if args.quick else []),
