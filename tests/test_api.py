@@ -156,3 +156,21 @@ def test_evaluate_agrees_with_batch(cli, tmp_path):
     ok = library["status"] == "ok"
     assert written.loc[ok.to_numpy(), "peak_force"].tolist() == pytest.approx(
         library.loc[ok, "peak_force"].tolist(), rel=1e-12)
+
+
+def test_paper_report_agrees_with_the_cli(cli):
+    from fruitimpact.cli.common import dump_json  # the CLI's JSON of the same report (NaN as null)
+
+    assert cli.json("paper") == json.loads(dump_json(fi.paper_report()))
+
+
+def test_restitution_table_agrees_with_models(cli):
+    rows = json.loads(cli.ok("models", "--json", "--model", "hunt-crossley", "--model", "lankarani-nikravesh"))
+    table = fi.restitution_table(["hunt-crossley", "lankarani-nikravesh"])
+    assert len(rows) == len(table)
+    for row, (_, expected) in zip(rows, table.iterrows()):
+        for key, value in row.items():
+            if isinstance(value, float):
+                assert value == pytest.approx(float(expected[key]), rel=1e-12), key
+            else:
+                assert value == expected[key], key
