@@ -174,3 +174,17 @@ def test_restitution_table_agrees_with_models(cli):
                 assert value == pytest.approx(float(expected[key]), rel=1e-12), key
             else:
                 assert value == expected[key], key
+
+
+@pytest.mark.parametrize("axis", ["surface", "firmness"])
+def test_risk_map_has_the_cli_axes_and_the_safe_height_checks(cli, axis):
+    """Both --map choices work through the one function, with the fruit's own criterion when none is given
+    (review of issue 15: firmness was refused, and a map without a criterion came out all NaN)."""
+    report = cli.json("safe-height", "--fruit", "apple", "--modulus", "3MPa", "--map", axis)
+    risk = fi.risk_map(by=axis, fruit="apple", **({"modulus": "3MPa"} if axis == "surface" else {}))
+    assert report["risk_map"]["safe_height"] == pytest.approx(risk["safe_height"], rel=1e-12)
+    assert all(math.isfinite(h) for h in risk["safe_height"].values())
+    with pytest.raises(ValueError, match="unknown input 'mas'"):
+        fi.risk_map(by=axis, fruit="apple", mas=1.0)
+    with pytest.raises(ValueError, match="mass is NaN"):
+        fi.risk_map(by=axis, fruit="apple", mass=float("nan"))

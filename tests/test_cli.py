@@ -539,6 +539,7 @@ def test_kernels_in_slices_give_the_same_rows(monkeypatch):
 
     table = {"drop_height": list(np.linspace(0.01, 0.5, 40)), "fruit": "apple",
              "yield_pressure": ["0.3MPa"] * 20 + [None] * 20,
+             "surface": ["cardboard", "foam-pad"] * 20,  # a group of plastic rows partly on crushing board
              "model": ["hunt-crossley"] * 30 + ["tsuji"] * 10}
     whole = module.evaluate(table)
     monkeypatch.setattr(module, "KERNEL_SLICE", 7)
@@ -546,3 +547,17 @@ def test_kernels_in_slices_give_the_same_rows(monkeypatch):
     assert whole["status"].tolist() == sliced["status"].tolist()
     for name in ("peak_force", "contact_duration", "restitution", "max_deflection"):
         np.testing.assert_array_equal(whole[name].to_numpy(), sliced[name].to_numpy(), err_msg=name)
+
+
+def test_the_default_table_choice_is_the_whole_groups(monkeypatch):
+    """Above TABLE_ROWS power-law rows the engine's table is used by default; the slices must not change that
+    choice (review of issue 15: a slice alone never reached it, 3x slower, and numbers depended on the cut)."""
+    import numpy as np
+
+    from fruitimpact.impact import evaluation as module
+
+    heights = np.linspace(0.01, 0.5, module.TABLE_ROWS + 5)
+    monkeypatch.setattr(module, "KERNEL_SLICE", 4096)
+    default = module.evaluate({"drop_height": heights, "fruit": "apple"})
+    table = module.evaluate({"drop_height": heights, "fruit": "apple"}, tabulated=True)
+    np.testing.assert_array_equal(default["peak_force"].to_numpy(), table["peak_force"].to_numpy())

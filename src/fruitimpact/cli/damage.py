@@ -87,11 +87,12 @@ def cmd_safe_height(args) -> int:
         args.map = "surface"
     report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
     if args.map:
-        from fruitimpact.handling.heights import risk_map
+        from fruitimpact.handling.heights import MAP_AXES, risk_map
 
-        # the map spans every value of its axis; the given one is the safe height's above
-        risk = _library_call(risk_map, by=args.map, **{k: v for k, v in kwargs.items() if k != args.map})
-        key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows", "safe_height"))
+        # the map spans every value of its axis; the value given is the safe height's, above
+        risk = _library_call(risk_map, by=args.map, **{k: v for k, v in kwargs.items() if k != MAP_AXES[args.map]})
+        key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows",
+                                                                     "safe_height"))
         report["risk_map"] = {"by": key, "safe_height": safe}
         if args.map_csv:
             from fruitimpact.impact.outputs import atomic_write

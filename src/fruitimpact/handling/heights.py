@@ -90,6 +90,30 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
     return heights, messages
 
 
+def _checked_inputs(inputs: dict, finder: str, mapped: str | None = None) -> dict:
+    """The inputs of one safe-height question, checked as one row before any work (the same checks for
+    :func:`safe_height` and :func:`risk_map`): no velocity or drop height (``finder`` finds it) nor the
+    ``mapped`` input, no unknown input, a criterion (the fruit's own when none is given, issue 14 item 5c)."""
+    from fruitimpact.impact.presets import fruit_criterion
+    from fruitimpact.impact.quantities import INPUTS
+    from fruitimpact.impact.validation import InputError
+
+    for name in ("velocity", "drop_height", mapped):
+        if name is not None and inputs.get(name) is not None:
+            raise InputError(f"{name} is what {finder}: leave it out", name)
+    unknown = [name for name in inputs if name not in INPUTS]
+    if unknown:
+        raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
+    criterion = inputs.get("criterion")
+    if criterion == "none":
+        raise InputError("criterion must be given for a safe height: pressure, shear or energy (the onset height "
+                         "changes by an order of magnitude between them)", "criterion")
+    inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), criterion)}
+    given = {name: value for name, value in inputs.items() if value is not None}
+    _check_row(given)
+    return given
+
+
 def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     """The safe drop height of one fruit on one surface [m], with its sensitivities.
 
@@ -127,26 +151,8 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     Onset of bruising under the Hertz contact: K. L. Johnson, *Contact Mechanics* (1985) eq 3.45 and §11.4;
     the shear criterion after Yuwana & Duprat (1998); docs/bruise.md.
     """
-    from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.validation import InputError
-
-    for name in ("velocity", "drop_height"):
-        if inputs.get(name) is not None:
-            raise InputError(f"{name} is what safe-height finds: leave it out", name)
-    unknown = [name for name in inputs if name not in INPUTS]
-    if unknown:
-        raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
-    from fruitimpact.impact.presets import fruit_criterion
-
-    criterion = inputs.get("criterion")
-    if criterion == "none":
-        raise InputError("criterion must be given for a safe height: pressure, shear or energy (the onset height "
-                         "changes by an order of magnitude between them)", "criterion")
-    # none given: the criterion the literature supports for the fruit (issue 14 item 5c), named in the result
-    inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), criterion)}
-    criterion = inputs["criterion"]
-    given = {name: value for name, value in inputs.items() if value is not None}
-    _check_row(given)
+    given = _checked_inputs(inputs, "safe-height finds")
+    criterion = given["criterion"]
     names = SENSITIVITY_INPUTS.get(criterion, ())
     cases = [given]
     if sensitivity:
@@ -197,8 +203,8 @@ __all__ = ["HIGHEST", "LOWEST", "SENSITIVITY_INPUTS", "safe_height", "safe_heigh
 MAP_HEIGHTS = 30
 #: Moduli of a firmness map [Pa].
 MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
-#: What a risk map can run across.
-MAP_AXES = ("surface", "modulus")
+#: What a risk map can run across (the ``--map`` choices) → the input it varies.
+MAP_AXES = {"surface": "surface", "firmness": "modulus"}
 
 
 def risk_map(*, by: str = "surface", **inputs) -> dict:
@@ -208,7 +214,8 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     Parameters
     ----------
     by : str
-        ``"surface"`` (every library surface but the rigid plane) or ``"modulus"`` (``MAP_MODULI``, 1–10 MPa).
+        ``"surface"`` (every library surface but the rigid plane) or ``"firmness"`` (the fruit modulus over
+        ``MAP_MODULI``, 1–10 MPa).
     **inputs
         As for :func:`safe_height` (fruit, model, criterion, …; not the velocity, drop height or the
         mapped input).
@@ -216,7 +223,7 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     Returns
     -------
     dict
-        ``by``, ``columns`` (surface names or moduli [Pa]), ``heights`` (``MAP_HEIGHTS`` drop heights
+        ``by`` (the input varied: ``surface`` or ``modulus``), ``columns`` (surface names or moduli [Pa]), ``heights`` (``MAP_HEIGHTS`` drop heights
         [m], 5 mm to 2 m, log-spaced), ``rows`` (one dict per grid point: the mapped value,
         ``drop_height``, ``bruise_margin``, ``bruised``, ``bruise_volume`` [m³], ``peak_force`` [N],
         ``status``) and ``safe_height`` (column → safe height [m]).
@@ -244,12 +251,11 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
 
     if by not in MAP_AXES:
         raise InputError(f"by must be one of {', '.join(MAP_AXES)}; got {by!r}", "map")
-    for name in ("velocity", "drop_height", by):
-        if inputs.get(name) is not None:
-            raise InputError(f"{name} is set by the risk map: leave it out", name)
+    key = MAP_AXES[by]
+    base = _checked_inputs(inputs, "the risk map spans", mapped=key)
     heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
-    columns = [name for name in SURFACE_CHOICES if name != "rigid"] if by == "surface" else list(MAP_MODULI)
-    base = {name: value for name, value in inputs.items() if value is not None}
+    columns = [name for name in SURFACE_CHOICES if name != "rigid"] if key == "surface" else list(MAP_MODULI)
+    by = key
     n = len(columns) * heights.size
     table = {name: [value] * n for name, value in base.items()}
     table[by] = [c for c in columns for _ in heights]

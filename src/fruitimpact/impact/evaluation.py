@@ -196,6 +196,9 @@ def _plausibility(inputs: InputColumns, warnings: WarningBook, detail: bool) -> 
 #: stops any run within about half a second, even at the slowest kernels' ~30,000 rows/s (damped
 #: plastic contact), where one call on a 500,000-row chunk used to hold it for 16 s (issue 15 item 5).
 KERNEL_SLICE = 16_384
+#: Rows of a group above which power-law rows use the engine's table by default (as
+#: ``engine.powerlaw.powerlaw_characteristics`` decides for one call).
+TABLE_ROWS = 20_000
 
 
 def in_slices(kernel, *args):
@@ -396,6 +399,9 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
         idx, sel = _selection(valid if len(keys) == 1 else valid & (groups == key))
         if idx.size == 0:
             continue
+        # the engine's table pays for its build above TABLE_ROWS rows: decided on the whole group, before
+        # in_slices cuts it (a slice alone would never use it, and the numbers would depend on the cut)
+        group_tabulated = tabulated if tabulated is not None else idx.size > TABLE_ROWS
         group_plastic = plastic[idx]
         if group_plastic.any():  # elastic-plastic or layered rows: the plastic engine
             elastic_rows = idx[~group_plastic]
@@ -403,22 +409,22 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             group = np.empty((idx.size, N_CHARACTERISTICS))
             if plastic_block is None:
                 plastic_block = np.full((rows, len(PLASTIC_COLUMNS)), np.nan)
-            engine = crushing_characteristics if crushing[plastic_rows].all() else plastic_characteristics
-            if crushing[plastic_rows].any() and not crushing[plastic_rows].all():
-                engine = _mixed_crushing(crushing[plastic_rows])
             group[group_plastic], plastic_block[plastic_rows] = in_slices(
-                engine, mass[plastic_rows], velocity[plastic_rows], stiffness[plastic_rows], radius[plastic_rows],
+                _plastic_engine, crushing[plastic_rows], mass[plastic_rows], velocity[plastic_rows],
+                stiffness[plastic_rows], radius[plastic_rows],
                 contact_modulus[plastic_rows], yield_pressure[plastic_rows], layer_stiffness[plastic_rows],
                 bottoming[plastic_rows], factor[plastic_rows])
             if elastic_rows.size:
                 group[~group_plastic] = in_slices(solver.batch, law, law_stiffness[elastic_rows],
                                                   factor[elastic_rows], mass[elastic_rows], velocity[elastic_rows],
-                                                  radius[elastic_rows], step[elastic_rows], tabulated)
+                                                  radius[elastic_rows], step[elastic_rows],
+                                                  tabulated if tabulated is not None else
+                                                  elastic_rows.size > TABLE_ROWS)
             reference = None  # rk4 is refused for these rows
             sel = idx
         else:
             arguments = (law_stiffness[sel], factor[sel], mass[sel], velocity[sel], radius[sel], step[sel],
-                         tabulated)
+                         group_tabulated)
             group = in_slices(solver.batch, law, *arguments)
             reference = in_slices(SOLVERS["accurate"].batch, law, *arguments) if solver.checked else None
         judge(group, idx, status, messages, solver=solver, velocity=velocity, step=step, reference=reference,
@@ -623,15 +629,18 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
     return {name: columns[name] for name in (*DAMAGE_NAMES, "bruise_energy")}
 
 
-def _mixed_crushing(crushing: np.ndarray):
-    """The plastic engine for a group of rows of which only ``crushing`` ones are on a board that crushes."""
-    def engine(*columns):
-        out = np.empty((crushing.size, N_CHARACTERISTICS))
-        extra = np.empty((crushing.size, len(PLASTIC_COLUMNS)))
-        for mask, run in ((crushing, crushing_characteristics), (~crushing, plastic_characteristics)):
-            out[mask], extra[mask] = run(*(np.asarray(c)[mask] for c in columns))
-        return out, extra
-    return engine
+def _plastic_engine(crushing: np.ndarray, *columns):
+    """The plastic engine of rows (``columns`` as for ``plastic_characteristics``), the rows on a board that
+    crushes (``crushing``, one flag per row: sliced with the rows by ``in_slices``) by the crushing engine."""
+    if crushing.all():
+        return crushing_characteristics(*columns)
+    if not crushing.any():
+        return plastic_characteristics(*columns)
+    out = np.empty((crushing.size, N_CHARACTERISTICS))
+    extra = np.empty((crushing.size, len(PLASTIC_COLUMNS)))
+    for mask, run in ((crushing, crushing_characteristics), (~crushing, plastic_characteristics)):
+        out[mask], extra[mask] = run(*(np.asarray(c)[mask] for c in columns))
+    return out, extra
 
 
 def _selection(mask: np.ndarray, idx: np.ndarray | None = None, sel=None):
