@@ -271,10 +271,11 @@ def test_missing_file_folder_and_unsupported_format(tmp_path):
 
 
 @pytest.mark.parametrize("kwargs,match", [
-    ({"rate": -1.0}, r"rate must be a finite number > 0 Hz"),
-    ({"rate": math.inf}, r"rate must be a finite number > 0 Hz"),
+    ({"rate": -1.0}, r"rate must be a finite number of Hz in \(0, 1e\+07\]"),
+    ({"rate": math.inf}, r"rate must be a finite number of Hz in \(0, 1e\+07\]"),
+    ({"rate": 1e12}, r"rate must be a finite number of Hz in \(0, 1e\+07\]"),  # buffers of terabytes
     ({"rate": True}, r"rate must be a number"),
-    ({"rate": "20kHz"}, r"rate must be a number"),
+    ({"rate": "20 parsecs"}, r"rate must be a sample rate"),
     ({"column": 3}, r"column must be a lane name"),
     ({"lanes": 0}, r"lanes must be an integer >= 1"),
     ({"lanes": 2}, r"lanes applies to raw float32 files only"),

@@ -1,7 +1,7 @@
-"""``python -m fruitimpact``: the same as the ``fruitimpact`` console script."""
+"""``python -m fruitimpact``: the same as the ``fruitimpact`` console script (its Ctrl-C and numba start-up)."""
 
 import sys
 
 from fruitimpact.cli import main
 
-sys.exit(main(sys.argv[1:]))
+sys.exit(main())

@@ -45,6 +45,8 @@ def _redeliver_interrupts_from_callbacks() -> None:
     line and exit status 130.  Raising it inside the hook itself would only be reported as ignored too."""
     import signal
 
+    if not hasattr(signal, "SIGALRM"):  # Windows: no one-shot timer; Python's own report stands
+        return
     default_hook = sys.unraisablehook
 
     def interrupt(signum, frame):
@@ -58,6 +60,14 @@ def _redeliver_interrupts_from_callbacks() -> None:
         default_hook(unraisable)
 
     sys.unraisablehook = hook
+
+
+def _cancel_redelivery() -> None:
+    """A redelivery still pending when ``main`` ends would interrupt whoever called it: cancel it."""
+    import signal
+
+    if hasattr(signal, "setitimer"):
+        signal.setitimer(signal.ITIMER_REAL, 0)
 
 
 def main(argv=None) -> int:
@@ -90,6 +100,9 @@ def main(argv=None) -> int:
         return 130
     except BrokenPipeError:  # e.g. piped into head
         return 0
+    finally:
+        if console:
+            _cancel_redelivery()
 
 
 _EXPORTS = {"UsageError": "common", "dump_json": "common", "format_result_table": "simulate"}

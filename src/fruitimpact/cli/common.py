@@ -252,17 +252,21 @@ class _AfterNumbaImport:
     def find_spec(self, name, path=None, target=None):
         if name != "numba":
             return None
-        sys.meta_path.remove(self)
-        import importlib.util
+        import importlib.machinery
 
-        spec = importlib.util.find_spec(name)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
         if spec is None or spec.loader is None:
             return spec
         run_module = spec.loader.exec_module
 
         def exec_module(module):
+            if self in sys.meta_path:  # once: a probe (find_spec alone) does not use the hook up
+                sys.meta_path.remove(self)
             run_module(module)
-            _start_numba_target()
+            try:
+                _start_numba_target()
+            except Exception:  # an optimisation only: numba starts its target itself on first use
+                pass
 
         spec.loader.exec_module = exec_module
         return spec

@@ -9,6 +9,7 @@ import sys
 
 from fruitimpact.cli.common import PROG, UsageError, _library_call, dump_json
 from fruitimpact.impact.units import parse_quantity
+from fruitimpact.signals.settings import MAX_RATE
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
@@ -114,7 +115,7 @@ def cmd_analyze(args) -> int:
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.stream import StreamAnalyzer
 
-    rate = _float("--rate", args.rate, "frequency")
+    rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
     if lanes is None:
         raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
@@ -332,7 +333,7 @@ def cmd_synth(args) -> int:
     if args.restitution is not None and args.alpha is not None:
         raise UsageError("give either --restitution or --alpha, not both")
     sensor_kwargs = dict(
-        rate=_float("--rate", args.rate, "frequency"),
+        rate=_float("--rate", args.rate, "frequency", high=MAX_RATE),
         noise=_float("--noise", args.noise, "dimensionless", low_inclusive=True, high=1.0),
         drift=_float("--drift", args.drift, "dimensionless", low=-math.inf),
         hum_amplitude=_float("--hum", args.hum, "force", low_inclusive=True),
@@ -414,7 +415,7 @@ def cmd_stream(args) -> int:
     from fruitimpact.signals.analysis import public
     from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve
 
-    rate = _float("--rate", args.rate, "frequency")
+    rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
     if rate is None:
         raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
     if not (str(args.lanes).isdigit() and 1 <= int(args.lanes) <= 256):

@@ -77,7 +77,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.signals.filters import butterworth_sos, solve_small
-from fruitimpact.signals.settings import DetectorSettings
+from fruitimpact.signals.settings import DetectorSettings, check_rate
 
 __all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
 
@@ -553,9 +553,9 @@ class Detector:
     """
 
     def __init__(self, rate: float, settings: DetectorSettings | None = None, lanes: int = 1):
-        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)) \
-                or not math.isfinite(float(rate)) or not float(rate) > 0:
-            raise ValueError(f"rate must be a finite number of Hz in (0, inf); got {rate!r}")
+        rate = check_rate(rate)
+        if rate is None:
+            raise ValueError("rate must be a finite number of Hz > 0; got None")
         if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= 1024:
             raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
         if settings is None:

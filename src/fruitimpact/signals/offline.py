@@ -69,10 +69,11 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     from fruitimpact.signals.options import _number, analysis_settings
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.recording import Recording
+    from fruitimpact.signals.settings import MAX_RATE
     from fruitimpact.signals.stream import StreamAnalyzer
 
     lanes = check_integer("lanes", lanes, 1)
-    rate_value = None if rate is None else _number("--rate", rate, "frequency")
+    rate_value = None if rate is None else _number("--rate", rate, "frequency", high=MAX_RATE)
     analysis_settings(rate_value if rate_value is not None else 1e12, rate_value is not None, **options)
     if isinstance(source, Recording):
         names, start, chunks, rate_value = list(source.lanes), source.start_time, None, source.rate

@@ -104,3 +104,34 @@ class DetectorSettings:
                 or any(b <= a for a, b in itertools.pairwise(harmonics))):
             raise ValueError(f"hum_harmonics must be 1 to 4 ascending integers in [1, 16]; got {harmonics!r}")
         object.__setattr__(self, "hum_harmonics", tuple(int(k) for k in harmonics))
+
+
+#: Highest sample rate accepted [Hz]: force plates on lines record at 1–100 kHz; 10 MHz leaves room for any
+#: acquisition while refusing a rate whose buffers could not be held (1e12 Hz asked for terabytes).
+MAX_RATE = 10e6
+
+
+def check_rate(rate, argument: str = "rate") -> float | None:
+    """A sample rate [Hz] (a number or a string with a unit, ``"20kHz"``) as a float in (0, ``MAX_RATE``]; None
+    stays None.  ``InputError`` naming ``argument`` otherwise."""
+    import math
+
+    import numpy as np
+
+    from fruitimpact.impact.units import parse_quantity
+    from fruitimpact.impact.validation import InputError
+
+    if rate is None:
+        return None
+    if isinstance(rate, str):
+        try:
+            rate = parse_quantity(rate, "frequency")
+        except ValueError:
+            raise InputError(f"{argument} must be a sample rate (a number of Hz, or with a unit: 20kHz); got "
+                             f"{rate!r}", argument) from None
+    if isinstance(rate, (bool, np.bool_)) or not isinstance(rate, (int, float, np.integer, np.floating)):
+        raise InputError(f"{argument} must be a number of samples per second [Hz] > 0; got {rate!r}", argument)
+    rate = float(rate)
+    if not math.isfinite(rate) or not 0.0 < rate <= MAX_RATE:
+        raise InputError(f"{argument} must be a finite number of Hz in (0, {MAX_RATE:.0e}]; got {rate!r}", argument)
+    return rate

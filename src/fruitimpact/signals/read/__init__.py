@@ -154,6 +154,8 @@ def open_recording(path, *, rate: float | None = None, column: str | None = None
     if isinstance(lanes, (bool, np.bool_)) or not isinstance(lanes, (int, np.integer)) or lanes < 1:
         raise InputError(f"lanes must be an integer >= 1 (interleaved lanes of a raw float32 file); got {lanes!r}",
                          "lanes")
+    if format is None and Path(path).suffix.lower() not in EXTENSIONS:
+        check_file(path)  # a missing file is said to be missing, not to have an unsupported extension
     kind = recording_format(path, format)
     if lanes != 1 and kind != "f32":
         raise InputError(f"lanes applies to raw float32 files only (.f32, .bin, .raw); got lanes={lanes} for a "

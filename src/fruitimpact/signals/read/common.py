@@ -90,15 +90,10 @@ def read_exactly(handle, path, position: int, size: int) -> bytes:
 
 
 def check_rate(rate) -> float | None:
-    """``rate`` [Hz] as a float (None stays None); refused unless a finite number > 0."""
-    if rate is None:
-        return None
-    if isinstance(rate, (bool, np.bool_)) or not isinstance(rate, (int, float, np.integer, np.floating)):
-        raise InputError(f"rate must be a number of samples per second [Hz] > 0; got {rate!r}", "rate")
-    rate = float(rate)
-    if not math.isfinite(rate) or rate <= 0.0:
-        raise InputError(f"rate must be a finite number > 0 Hz; got {rate!r}", "rate")
-    return rate
+    """``rate`` [Hz] as a float (None stays None): ``signals.settings.check_rate``, the one check of a rate."""
+    from fruitimpact.signals.settings import check_rate as check
+
+    return check(rate)
 
 
 def need_rate(path, rate, why: str) -> float:
