@@ -5,8 +5,8 @@ Each figure is measured beside its baseline in the same run:
 
 * the elastic–plastic engine (Thornton, with and without viscous damping, on a half-space and on a cushion
   layer) against a loop of SciPy ``solve_ivp`` (DOP853, rtol 1e-10) integrating the same law with its history;
-* ``safe-height`` (a root search of ~30 evaluations) against one ``batch.evaluate`` of the same row;
-* a line audit against ``batch.evaluate`` of the same members at every transfer point.
+* ``safe-height`` (a root search of ~30 evaluations) against one ``fi.evaluate`` of the same row;
+* a line audit against ``fi.evaluate`` of the same members at every transfer point.
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def damage_benchmarks(record, quick: bool) -> None:
     safe_height(criterion="shear", fruit="apple", sensitivity=False)
     search = best_of(lambda: safe_height(criterion="shear", fruit="apple", sensitivity=False), 5)
     one = best_of(lambda: evaluation({"criterion": ["shear"], "fruit": ["apple"], "drop_height": [0.05]}), 5)
-    record("safe-height root search (shear, library apple)", search * 1e3, "one batch.evaluate of that row",
+    record("safe-height root search (shear, library apple)", search * 1e3, "one fi.evaluate of that row",
            one * 1e3, "ms", "Illinois on ln h to 1e-9", of_baseline=True)
 
     from fruitimpact.handling.line import TransferPoint, audit
@@ -117,7 +117,7 @@ def damage_benchmarks(record, quick: bool) -> None:
                         "surface": "fruit" if p.fruit_on_fruit else p.surface, "criterion": "shear"})
 
     floor = best_of(evaluate_all, 1)
-    record(f"line audit, {n:,} fruit × 5 transfer points", line_time, "batch.evaluate of the same impacts", floor,
+    record(f"line audit, {n:,} fruit × 5 transfer points", line_time, "fi.evaluate of the same impacts", floor,
            "s", "incidence, volumes, cumulation", of_baseline=True)
 
     # issue 14 item 9: the line against one population of its N·P impacts (one table, every point's rows
@@ -129,7 +129,7 @@ def damage_benchmarks(record, quick: bool) -> None:
     stacked["criterion"] = np.full(n * len(points), "shear", dtype=object)
     population = best_of(lambda: evaluation(stacked), 1)
     record(f"line audit against one population of its {n * len(points):,} impacts (goal ≤ 1.5×)", line_time,
-           "batch.evaluate of the N·P impacts as one table", population, "s", "issue 14 item 9", of_baseline=True)
+           "fi.evaluate of the N·P impacts as one table", population, "s", "issue 14 item 9", of_baseline=True)
     plastic = {**members, "yield_pressure": np.full(n, 3.2e5)}
     audit(points[:1], {k: v[:10] for k, v in plastic.items()}, 10, "shear", {}, ())
     plastic_time = best_of(lambda: audit(points, plastic, n, "shear", {}, ()), 1)

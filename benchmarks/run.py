@@ -153,14 +153,14 @@ def max_rel_error(values, reference):
 
 
 def fruit_columns(rows, seed=1):
-    """A population as ``batch.evaluate`` takes it: mass, modulus, velocity and restitution [SI]."""
+    """A population as ``fi.evaluate`` takes it: mass, modulus, velocity and restitution [SI]."""
     rng = np.random.default_rng(seed)
     return {"mass": rng.normal(0.115, 0.01, rows), "modulus": 3e6 * np.exp(rng.normal(0.0, 0.2, rows)),
             "velocity": rng.uniform(0.5, 1.5, rows), "restitution": rng.uniform(0.3, 0.8, rows)}
 
 
 def numpy_floor(columns):
-    """The floor of ``batch.evaluate``: a plain NumPy evaluation, on the same arrays, of only the
+    """The floor of ``fi.evaluate``: a plain NumPy evaluation, on the same arrays, of only the
     contact stiffness (eq 9), the restitution of the paper's Hunt–Crossley damping (Newton on the
     exact relation (1 + x) = (1 - e x) exp((1 + e) x), 8 steps) and δ_max in closed form."""
     m, E, v, e0 = columns["mass"], columns["modulus"], columns["velocity"], columns["restitution"]
@@ -189,7 +189,7 @@ def end_to_end(record, quick):
     evaluate({k: a[:50000] for k, a in columns.items()}, tabulated=True)
     floor = best_of(lambda: numpy_floor(columns), 3)
     ours = best_of(lambda: evaluate(columns, tabulated=True), 3)
-    record(f"batch.evaluate, {n_eval:,} rows (all characteristics, status)", ours,
+    record(f"fi.evaluate, {n_eval:,} rows (all characteristics, status)", ours,
            "NumPy: k_c, e and δ_max only", floor, "s", "target: within 3×", of_baseline=True)
 
     simulate(model="tsuji-clamped")

@@ -6,9 +6,9 @@
   against the I/O floor: ``pyarrow.csv.read_csv`` of IN plus
   ``pyarrow.parquet.write_table`` of a table with the output's size and schema.
   Measured as a subprocess (start-up included) and in-process; the in-process run
-  is also given without ``batch.evaluate`` (its time measured on the same rows).
+  is also given without ``fi.evaluate`` (its time measured on the same rows).
 * ``population``: ``population -n N`` (summary only, in-process, start-up
-  excluded) against ``batch.evaluate`` of the same drawn members.
+  excluded) against ``fi.evaluate`` of the same drawn members.
 
 Every figure is the best of ``--repeats`` runs.  From ``benchmarks/run.py``:
 ``from runs import main as runs_main; runs_main(["--rows", "200000"])``.
@@ -77,7 +77,7 @@ def batch(rows: int, repeats: int, folder: Path) -> list[tuple]:
     return [(f"batch {rows:,} rows CSV → Parquet, subprocess", sub, "I/O floor", io_floor),
             (f"batch {rows:,} rows CSV → Parquet, in-process", inproc, "I/O floor", io_floor),
             (f"batch {rows:,} rows, in-process without evaluate", inproc - evaluation, "I/O floor", io_floor),
-            (f"batch.evaluate of the same {rows:,} rows", evaluation, "I/O floor", io_floor)]
+            (f"fi.evaluate of the same {rows:,} rows", evaluation, "I/O floor", io_floor)]
 
 
 def population(rows: int, repeats: int, folder: Path) -> list[tuple]:
@@ -104,7 +104,7 @@ def population(rows: int, repeats: int, folder: Path) -> list[tuple]:
     finally:
         os.chdir(cwd)
     evaluation = best_of(lambda: [evaluate(m, tabulated=True) for m in members], repeats)
-    return [(f"population -n {rows:,}, summary only, in-process", run, "batch.evaluate, same members", evaluation)]
+    return [(f"population -n {rows:,}, summary only, in-process", run, "fi.evaluate, same members", evaluation)]
 
 
 def main(argv=None) -> list:

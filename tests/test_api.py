@@ -188,3 +188,34 @@ def test_risk_map_has_the_cli_axes_and_the_safe_height_checks(cli, axis):
         fi.risk_map(by=axis, fruit="apple", mas=1.0)
     with pytest.raises(ValueError, match="mass is NaN"):
         fi.risk_map(by=axis, fruit="apple", mass=float("nan"))
+
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: fi.simulate(curve_points=0), "curve_points must be an integer in"),
+    (lambda: fi.drop("30cm", fruit="apple", rest_height=-1.0), "rest_height must be a finite number > 0"),
+    (lambda: fi.drop("30cm", fruit="apple", rest_height=float("nan")), "rest_height must be a finite number"),
+    (lambda: fi.calibrate_classes([1.0, 2.0], ["a", "b"], "ab", "modulus"), "classes must be a sequence"),
+    (lambda: fi.analyze(np.zeros(100), rate=1e4, column="lane0"), "column applies to a recording file"),
+    (lambda: fi.analyze(np.zeros((5, 0)), rate=1e4), "at least one sample and one lane"),
+    (lambda: fi.analyze(["a", "b"], rate=1e4), "source must be a recording file"),
+    (lambda: fi.analyze(np.zeros(100), rate=1e12), "must be a number in"),
+    (lambda: fi.analyze(np.zeros(100), rate=1e4, fit="no"), "fit must be True or False"),
+    (lambda: fi.audit_line(3, rows=10, fruit="apple"), "line must be a line CSV"),
+    (lambda: fi.audit_line([], rows=10, fruit="apple"), "line must be a line CSV"),
+    (lambda: fi.read_line(True), "line must be a path"),
+    (lambda: fi.Detector(1e12), r"rate must be a finite number of Hz in \(0, 1e\+07\]"),
+])
+def test_the_functions_refuse_nonsense_with_one_line(call, match):
+    """Found by the review of issue 15: each was accepted silently or failed deep inside (a file descriptor
+    3 was even opened and closed as a line file)."""
+    with pytest.raises(ValueError, match=match) as caught:
+        call()
+    assert "\n" not in str(caught.value)
+
+
+def test_unit_strings_are_read_where_the_cli_reads_them(recording):
+    path, force, rate = recording
+    assert fi.Detector("20kHz").rate == 20_000.0
+    assert fi.read_recording(path, rate="20kHz").rate == pytest.approx(rate)
+    by_units = fi.analyze(force, rate="20kHz", clip=("-1kN", "2kN"), thresholds=[1e7], sort_by="firmness_c_star")
+    assert len(by_units) == 2

@@ -155,7 +155,7 @@ def _status_line(summary) -> str:
 
 def _check_constants(constants: dict, text: dict, given=()) -> None:
     """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
-    energy criterion's threshold), before any chunk runs (one row through batch.evaluate)."""
+    energy criterion's threshold), before any chunk runs (one row through impact.evaluation.evaluate)."""
     from fruitimpact.impact.evaluation import evaluate
     from fruitimpact.impact.quantities import INPUTS
 

@@ -1,6 +1,6 @@
 """Drops: a fruit let fall from a height bounces on a surface until it rests.
 
-Each impact is a full impact of ``batch.evaluate`` at its own velocity.  The
+Each impact is a full impact of ``impact.evaluation.evaluate`` at its own velocity.  The
 rebound speed of one impact is the impact speed of the next, V_{n+1} = e_n V_n
 (no drag), after a flight of 2 V_{n+1}/g.
 
@@ -108,7 +108,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
     from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.validation import InputError
+    from fruitimpact.impact.validation import InputError, check_number
 
     for name in ("velocity", "drop_height"):
         if name in inputs:
@@ -121,6 +121,8 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     if bounces == "constant" and any(inputs.get(name) is not None for name in ("alpha", "damping")):
         raise InputError("bounces constant recalibrates every impact to one restitution: give restitution (with "
                          "alpha or damping the law sets e at each speed, which is bounces material)", "bounces")
+    rest_height = check_number("rest_height", rest_height, low=0.0, low_inclusive=False, high=1.0,
+                               high_inclusive=True)
     if not (isinstance(max_impacts, int) and 1 <= max_impacts <= 1000):
         raise InputError(f"max_impacts must be an integer in [1, 1000]; got {max_impacts!r}", "max_impacts")
     if inputs.get("surface") == "fruit":

@@ -4,7 +4,7 @@ The bruise margin of an impact (``bruise_margin``: the criterion's stress or
 energy over its threshold, minus 1) rises with the drop height; the safe drop
 height is its root, found on the logarithm of the height by the Illinois
 variant of regula falsi (bracketed, superlinear) on all rows of a table at
-once: every iteration is one ``batch.evaluate`` of the table.  It is a root,
+once: every iteration is one ``impact.evaluation.evaluate`` of the table.  It is a root,
 not a scan: to a relative tolerance of 1e-9 in h.
 
 Checked (tests/test_heights.py) against the closed form of elastic Hertz on a

@@ -38,15 +38,42 @@ class TransferPoint:
     fruit_on_fruit: bool = False
 
 
+def _points(line) -> list[TransferPoint]:
+    """The transfer points of ``line``: a line file (a path) read by :func:`read_line`, or a non-empty sequence of
+    :class:`TransferPoint` with heights [m] > 0 and library surfaces; ``InputError`` naming ``line`` otherwise."""
+    import os
+
+    from fruitimpact.impact.registries import SURFACE_CHOICES
+    from fruitimpact.impact.validation import InputError
+
+    if isinstance(line, (str, os.PathLike)):
+        return read_line(line)
+    if not isinstance(line, (list, tuple)) or not line or not all(isinstance(p, TransferPoint) for p in line):
+        raise InputError("line must be a line CSV (a path) or a non-empty list of TransferPoint; got "
+                         f"{type(line).__name__}", "line")
+    for point in line:
+        height = point.drop_height
+        if isinstance(height, bool) or not isinstance(height, (int, float)) or not 0.0 < height < math.inf:
+            raise InputError(f"transfer point {point.name!r}: drop_height must be a number of m > 0; got {height!r}",
+                             "line")
+        if point.surface not in SURFACE_CHOICES:
+            raise InputError(f"transfer point {point.name!r}: surface must be one of {', '.join(SURFACE_CHOICES)}; "
+                             f"got {point.surface!r}", "line")
+    return list(line)
+
+
 def read_line(path) -> list[TransferPoint]:
     """The transfer points of a line CSV (header ``name,drop_height,surface[,fruit_on_fruit]``;
     ``#`` comment lines allowed).  ``ValueError`` naming the line and the column of the first problem:
     unknown or missing columns, ragged rows, unknown surfaces, heights that are not positive."""
     import csv
+    import os
 
     from fruitimpact.impact.registries import SURFACE_CHOICES
     from fruitimpact.impact.units import parse_quantity
 
+    if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
+        raise ValueError(f"line must be a path to a line CSV; got {path!r}")
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
             lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
@@ -276,7 +303,7 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
 
     rows = check_integer("rows", rows, 1, MAX_LINE_FRUIT)
     seed = check_integer("seed", seed, 0)
-    points = line if isinstance(line, (list, tuple)) else read_line(line)
+    points = _points(line)
     if criterion == "none":
         raise InputError("criterion must be given for a line audit: pressure, shear or energy (the onset height "
                          "changes by an order of magnitude between them)", "criterion")

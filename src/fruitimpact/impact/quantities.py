@@ -7,7 +7,7 @@ shown (display unit and scale) and read (its dimension in
 that is plausible for fruit (``plausible``: outside it the result carries a
 warning), its default, and the CLI option that sets it.  From this table come
 the options of ``fruitimpact simulate``, ``sweep`` and ``population``, the
-columns ``batch.evaluate`` accepts and returns, the validation of inputs,
+columns ``impact.evaluation.evaluate`` accepts and returns, the validation of inputs,
 the fields of results and every label, unit and axis of the tables and
 figures.  Add a quantity here, and it is an option, a column and a result.
 
@@ -136,7 +136,7 @@ def _table(*quantities: Quantity) -> dict[str, Quantity]:
 
 _JONATHAN = "(default: the paper's Jonathan apple)"
 
-#: Inputs of one impact: keywords of ``simulate``, columns of ``batch.evaluate``,
+#: Inputs of one impact: keywords of ``simulate``, columns of ``impact.evaluation.evaluate``,
 #: options of ``simulate``/``sweep``/``population``.  Numeric inputs first, then text.
 INPUTS: dict[str, Quantity] = _table(
     Quantity("mass", "M", "mass M", "mass", "g", 1e3, f"fruit mass {_JONATHAN}",

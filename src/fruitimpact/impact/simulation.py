@@ -7,7 +7,7 @@
 0.577
 
 Everything is SI; strings with units are accepted too (``Fruit(mass="115g")``).
-``simulate()`` is ``batch.evaluate`` of one row: the same validation (a
+``simulate()`` is ``impact.evaluation.evaluate`` of one row: the same validation (a
 ``ValueError`` with the CLI's message, naming the argument), the same
 kernels and the same judgement of the result (``status``, ``message``,
 ``warnings``).
@@ -448,6 +448,9 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
     nonlinear Kelvin–Voigt model, eqs 7–12, and its worked example, section 3); H. Hertz (1882);
     K. H. Hunt, F. R. E. Crossley, J. Appl. Mech. 42 (1975) 440–445.
     """
+    from fruitimpact.impact.validation import check_integer
+
+    curve_points = check_integer("curve_points", curve_points, 2, 10_000_000)
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
 

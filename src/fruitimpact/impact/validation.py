@@ -2,7 +2,7 @@
 
 One path for one value and for a column of a million: ``check_value`` (a
 ``Fruit`` field, a keyword of ``simulate``) and ``out_of_range`` (a column
-of ``batch.evaluate``) use the same ``Quantity.allowed`` range and the same
+of ``impact.evaluation.evaluate``) use the same ``Quantity.allowed`` range and the same
 words (``range_message``).  A refused input raises ``InputError``, a
 ``ValueError`` that carries the name of the argument it is about, so that
 the CLI can name the option without reading the message.

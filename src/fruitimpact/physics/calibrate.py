@@ -61,7 +61,7 @@ _TINY = np.finfo(float).tiny
 
 def law_params(family, stiffness, damping_factor, exponent=1.5):
     """Parameter matrix for the compiled force of ``family`` (rows of impacts): see
-    ``models.families.ForceFamily.params``."""
+    ``physics.families.ForceFamily.params``."""
     from fruitimpact.physics.families import FAMILIES
 
     return FAMILIES[family].params(stiffness, damping_factor, exponent)

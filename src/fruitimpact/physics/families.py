@@ -1,7 +1,7 @@
 """Force families: the form of the contact force, one record each.
 
 A *family* is a force law F(δ, δ̇) with a stiffness and a damping
-coefficient; the published *damping laws* (``models.laws``) only say how the
+coefficient; the published *damping laws* (``physics.laws``) only say how the
 damping follows from a restitution coefficient, and each belongs to one
 family.  The record says everything the rest of the package needs to know of
 a family: its engine code (``engine.forces``), the symbols and units of its

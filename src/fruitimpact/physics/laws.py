@@ -1,7 +1,7 @@
 """The published damping laws, one documented function each.
 
 Each function turns a restitution coefficient e ∈ (0, 1] into the
-dimensionless damping group of its force family (``models.families``), as
+dimensionless damping group of its force family (``physics.families``), as
 its authors published it:
 
 * power-law family F = K δ^1.5 (1 + c δ̇): χ = c·V_i;

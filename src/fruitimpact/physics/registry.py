@@ -1,8 +1,8 @@
 """Registry of damping laws and of calibrations.
 
 A *damping law* says which force family the contact follows
-(``models.families``) and how its damping follows from a restitution
-coefficient e: the published formula is a function of ``models.laws``.
+(``physics.families``) and how its damping follows from a restitution
+coefficient e: the published formula is a function of ``physics.laws``.
 A *calibration* says which e → damping rule is applied: the law's own
 published formula (``paper``), or the exact inverse of the restitution the
 law really produces (``exact``), which makes the simulated restitution equal
@@ -11,7 +11,7 @@ the requested one.
 Formulas were checked against the sources and public implementations listed
 in docs/models.md; the achieved-restitution tables there are produced by
 ``fruitimpact models`` and verified by an independent integration in
-tests/test_models.py.  Add a law by writing its function in ``models.laws``
+tests/test_models.py.  Add a law by writing its function in ``physics.laws``
 and registering a ``DampingLaw`` here; nothing else needs to change.
 """
 
@@ -46,7 +46,7 @@ class DampingLaw:
     clamp : bool
         Whether the fruit separates as soon as the force would become tensile.
     published : callable or None
-        The law's function of ``models.laws``: e → the family's dimensionless damping
+        The law's function of ``physics.laws``: e → the family's dimensionless damping
         group as published; None means undamped (λ = 0).
     note : str
         What else a user should know (aliases, unconfirmed transcriptions).

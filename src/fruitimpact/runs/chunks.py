@@ -1,7 +1,7 @@
 """One chunk of a run: evaluate its rows, summarise them, write its files.
 
 ``run_chunk`` is what a task does, in this process or on a Dask worker: it
-reads its inputs from the source, calls ``batch.evaluate``, writes the part
+reads its inputs from the source, calls ``impact.evaluation.evaluate``, writes the part
 file (every row, when the run keeps rows) and the summary file (populations),
 and returns the manifest record of the chunk, which the driver appends once
 the files are in place.
@@ -16,7 +16,7 @@ from fruitimpact.runs.workdir import write_part, write_summary
 
 
 def evaluate_rows(inputs, start: int, errors=None):
-    """``batch.evaluation`` of ``inputs`` (an ``Evaluation``: arrays and codes, no DataFrame).
+    """``impact.evaluation.evaluation`` of ``inputs`` (an ``Evaluation``: arrays and codes, no DataFrame).
 
     ``errors``: None, or a message per row that makes the row invalid unread (ragged CSV rows).
     Power-law rows always use the engine's table, so results do not depend on where

@@ -3,7 +3,7 @@
 A source knows its ``rows`` (None for a CSV file until read), its ``identity``
 (what determines the rows, for the job's fingerprint), the ``payloads`` the
 driver reads chunk by chunk, and the ``inputs`` a chunk's task hands to
-``batch.evaluate``.
+``impact.evaluation.evaluate``.
 
 Table files are read with pyarrow, streamed block by block: only empty cells
 are null ("not given"); a NaN, in any spelling, is a given value (refused by
@@ -76,7 +76,7 @@ def _estimate_csv_rows(path, size: int) -> int:
 def numeric_fast_path(column):
     """A column of plain numbers as float64 (nulls kept), else the column unchanged.
 
-    Text cells with units (``115g``) are left to ``batch.evaluate``, which parses
+    Text cells with units (``115g``) are left to ``impact.evaluation.evaluate``, which parses
     them cell by cell; columns of plain numbers, the common case, are converted
     here in one vectorised cast."""
     import pyarrow as pa

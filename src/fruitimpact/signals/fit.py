@@ -492,10 +492,28 @@ def _empty_result(message: str) -> dict:
 # ---------------------------------------------------------------------------------------------------------
 # Public API
 
+#: The dimension of each physical argument of the fit, for values given with a unit ("1 m/s", "150g").
+_DIMENSIONS = {"velocity": "velocity", "mass": "mass", "diameter": "length", "poisson": "dimensionless"}
+
+
+def _number(name, value) -> float:
+    """``value`` [SI] of argument ``name``: a number, or a string with a unit; ValueError naming it otherwise."""
+    from fruitimpact.impact.units import parse_quantity
+
+    try:
+        if isinstance(value, str):
+            return parse_quantity(value, _DIMENSIONS.get(name, "dimensionless"))
+        if isinstance(value, bool):
+            raise TypeError
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number (or a string with a unit); got {value!r}") from None
+
+
 def _positive(name, value):
     if value is None:
         return None
-    value = float(value)
+    value = _number(name, value)
     if not (math.isfinite(value) and value > 0.0):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return value
@@ -583,7 +601,7 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
         raise ValueError("give diameter and poisson together (the modulus needs both)")
     diameter = _positive("diameter", diameter)
     if poisson is not None:
-        poisson = float(poisson)
+        poisson = _number("poisson", poisson)
         if not (0.0 <= poisson < 0.5):
             raise ValueError(f"poisson must be in [0, 0.5), got {poisson!r}")
     t = np.asarray(time, dtype=float)

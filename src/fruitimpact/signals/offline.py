@@ -75,21 +75,34 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     lanes = check_integer("lanes", lanes, 1)
     rate_value = None if rate is None else _number("--rate", rate, "frequency", high=MAX_RATE)
     analysis_settings(rate_value if rate_value is not None else 1e12, rate_value is not None, **options)
+    from_file = isinstance(source, (str, bytes)) or hasattr(source, "__fspath__")
+    if not from_file:
+        for name, value, default in (("column", column, None), ("format", format, None), ("lanes", lanes, 1)):
+            if value != default:
+                raise InputError(f"{name} applies to a recording file; the samples given are already lanes", name)
     if isinstance(source, Recording):
+        if rate_value is not None and abs(rate_value - source.rate) > 1e-6 * source.rate:
+            raise InputError(f"argument --rate: {rate_value:g} Hz disagrees with the recording's {source.rate:g} Hz "
+                             f"(leave it out)", "rate")
         names, start, chunks, rate_value = list(source.lanes), source.start_time, None, source.rate
         samples = np.column_stack([source.lanes[name] for name in names])
-    elif isinstance(source, (str, bytes)) or hasattr(source, "__fspath__"):
+    elif from_file:
         reader = open_recording(source, rate=rate_value, column=column, format=format, lanes=lanes)
         names, start, rate_value, samples = list(reader.lane_names), reader.start_time, reader.rate, None
         chunks = reader.chunks(ANALYZE_CHUNK)
     else:
         if rate_value is None:
             raise InputError("argument --rate: required for an array of samples (the sample rate [Hz])", "rate")
-        samples = np.asarray(source, dtype=float)
+        try:
+            samples = np.asarray(source, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("source must be a recording file, a Recording or force samples [N] (numbers) of shape "
+                             "(n,) or (n, lanes)", "source") from None
         if samples.ndim == 1:
             samples = samples[:, None]
-        if samples.ndim != 2 or samples.shape[0] == 0:
-            raise InputError(f"source must be force samples of shape (n,) or (n, lanes); got shape {samples.shape}")
+        if samples.ndim != 2 or samples.shape[0] == 0 or samples.shape[1] == 0:
+            raise InputError(f"source must be force samples of shape (n,) or (n, lanes), at least one sample and one "
+                             f"lane; got shape {samples.shape}", "source")
         names, start, chunks = [f"lane{k}" for k in range(samples.shape[1])], 0.0, None
     if chunks is None:
         chunks = (samples[i:i + ANALYZE_CHUNK] for i in range(0, samples.shape[0], ANALYZE_CHUNK))

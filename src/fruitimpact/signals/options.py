@@ -54,6 +54,11 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     unknown = [name for name in options if name not in ANALYSIS_OPTIONS]
     if unknown:
         raise InputError(f"unknown analysis option {unknown[0]!r} (options: {', '.join(ANALYSIS_OPTIONS)})")
+    if not isinstance(options.get("fit", False), (bool, type(None))):
+        raise InputError(f"argument --fit: fit must be True or False; got {options['fit']!r}")
+    # the Python API may give a sequence where the CLI gives "A,B"
+    options = {name: ",".join(str(v) for v in value) if name in ("clip", "thresholds", "classes")
+               and isinstance(value, (list, tuple)) else value for name, value in options.items()}
     args = _Options({**ANALYSIS_DEFAULTS, **{k: v for k, v in options.items() if v is not None}})
     from fruitimpact.physics.constants import STANDARD_GRAVITY
     from fruitimpact.signals.analysis import Analysis

@@ -98,6 +98,9 @@ def calibrate(values, labels, classes, by: str) -> FirmnessClasses:
     The indices C and C*: eqs 1–2 of "Theoretical aspects about simulating the reaction to impact of apples on
     rigid plane surfaces"; the balanced accuracy: Brodersen et al., ICPR 2010.
     """
+    if isinstance(classes, str):
+        raise ValueError(f"classes must be a sequence of class names, softest first (e.g. ('soft', 'firm')); "
+                         f"got the string {classes!r}")
     values = np.asarray(values, dtype=float)
     labels = np.asarray(labels, dtype=object)
     classes = tuple(classes)

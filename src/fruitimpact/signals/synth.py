@@ -1,7 +1,7 @@
 """A synthetic impact force sensor: recordings with a known truth, for testing analysis code.
 
 Fruit fall onto a force plate.  Each impact's contact force F(t) is the
-project's exact Hunt–Crossley solution (``batch.evaluate`` for the
+project's exact Hunt–Crossley solution (``impact.evaluation.evaluate`` for the
 characteristics, ``engine.powerlaw.powerlaw_curves`` for the curve, evaluated at
 t − t_onset on the sample grid, so onsets fall anywhere between samples).  The
 sensor chain is applied in the physical order (impact-sensors.md §3.1):
@@ -226,7 +226,7 @@ class Impact:
         True first touch [s] from the start of the recording, >= 0.
     mass, diameter, modulus, poisson : float
         The fruit: mass [kg], diameter at the contact [m], flesh modulus E [Pa],
-        Poisson's ratio [-] (checked by ``batch.evaluate``).
+        Poisson's ratio [-] (checked by ``impact.evaluation.evaluate``).
     velocity, drop_height : float
         Impact speed [m/s] or drop height [m] (V = √(2 g h)): exactly one.
     restitution, alpha : float
