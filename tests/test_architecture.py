@@ -122,7 +122,9 @@ def test_import_contracts_hold():
 
 
 @pytest.mark.parametrize("argv", [["--help"], ["simulate", "--help"], ["simulate", "--mass", "-1"],
-                                  ["drop", "--model", "nonsense"], ["safe-height", "--diameter", "65 parsecs"]])
+                                  ["drop", "--model", "nonsense"], ["safe-height", "--diameter", "65 parsecs"],
+                                  ["analyze", "examples/line.csv", "--hum", "-5"],
+                                  ["stream", "--rate", "20000", "--poisson", "0.5"]])
 def test_the_console_path_answers_help_and_usage_errors_without_numba(argv):
     """Issue 15 item 4: the console script (``main()`` with no argv: the path that starts numba's target for
     the CLI) answers --help and a usage error before numba or pandas are imported, so in a fraction of
@@ -131,7 +133,7 @@ def test_the_console_path_answers_help_and_usage_errors_without_numba(argv):
             "try:\n    status = main()\nexcept SystemExit as exc:\n    status = exc.code\n"
             "print('STATUS', status, file=sys.stderr)\n"
             "for name in ('numba', 'pandas', 'pyarrow', 'matplotlib'):\n    print(name, name in sys.modules, file=sys.stderr)\n")
-    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120)
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120, cwd=ROOT)
     lines = done.stderr.splitlines()
     loaded = dict(line.split() for line in lines if line.split()[-1:] in (["True"], ["False"]))
     assert loaded == {"numba": "False", "pandas": "False", "pyarrow": "False", "matplotlib": "False"}, done.stderr
@@ -141,7 +143,7 @@ def test_the_console_path_answers_help_and_usage_errors_without_numba(argv):
     else:
         assert status == "2"
         message = [line for line in lines if line.startswith("fruitimpact")]
-        assert len(message) == 1 and f"argument --{argv[1].lstrip('-')}" in message[0], done.stderr
+        assert len(message) == 1 and f"argument {argv[-2]}" in message[0], done.stderr
 
 
 def test_help_starts_no_numba_and_no_pandas():

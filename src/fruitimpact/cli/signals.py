@@ -111,10 +111,6 @@ class _Progress:
 
 
 def cmd_analyze(args) -> int:
-    from fruitimpact.signals.analysis import public
-    from fruitimpact.signals.read import open_recording
-    from fruitimpact.signals.stream import StreamAnalyzer
-
     rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
     if lanes is None:
@@ -126,7 +122,12 @@ def cmd_analyze(args) -> int:
             check_output(args.plot, "--plot", FIGURE_FORMATS)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
-    analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)  # every option checked before the file is read
+    # every option checked before the file is read, and before the detector and the fit (numba) are imported
+    analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.read import open_recording
+    from fruitimpact.signals.stream import StreamAnalyzer
+
     try:
         source = open_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
     except ValueError as exc:
@@ -412,9 +413,6 @@ def add_synth_parser(sub) -> None:
 
 # -------------------------------------------------------------------------------------------- stream
 def cmd_stream(args) -> int:
-    from fruitimpact.signals.analysis import public
-    from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve
-
     rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
     if rate is None:
         raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
@@ -429,7 +427,9 @@ def cmd_stream(args) -> int:
         if not (str(args.listen).isdigit() and 0 <= int(args.listen) <= 65535):
             raise UsageError(f"argument --listen: must be a port in [0, 65535]; got {args.listen!r}")
         port = int(args.listen)
-    settings, analysis = analysis_from(args, rate)
+    settings, analysis = analysis_from(args, rate)  # plain checks first: a usage error imports no numba
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve
 
     def emit(report):
         sys.stdout.write(_json_line(public(report)) + "\n")

@@ -30,7 +30,7 @@ def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: 
     ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
     if not ok:
         bracket = "[" if low_inclusive else "("
-        raise InputError(f"argument {option}: must be a number in {bracket}{low:g}, {high:g}]; got {text!r}")
+        raise InputError(f"argument {option}: must be a number in {bracket}{low:.7g}, {high:.7g}]; got {text!r}")
     return value
 
 
@@ -61,10 +61,9 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
                and isinstance(value, (list, tuple)) else value for name, value in options.items()}
     args = _Options({**ANALYSIS_DEFAULTS, **{k: v for k, v in options.items() if v is not None}})
     from fruitimpact.physics.constants import STANDARD_GRAVITY
-    from fruitimpact.signals.analysis import Analysis
-    from fruitimpact.signals.detect import Detector, DetectorSettings
-    from fruitimpact.signals.sort import FirmnessClasses
+    from fruitimpact.signals.settings import DetectorSettings
 
+    # every plain check first: a usage error is answered before the detector and the fit (numba) are imported
     hum = _number("--hum", args.hum, "frequency")
     lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
     clip = (None, None)
@@ -89,18 +88,20 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         raise InputError("give either --pitch or --fruit-rate, not both")
     if fruit_rate is not None:
         pitch = 1.0 / fruit_rate
-    try:
-        settings = DetectorSettings(
-            k_on=_number("--k-on", args.k_on, "dimensionless"), k_off=_number("--k-off", args.k_off, "dimensionless"),
-            hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,), lowpass_cutoff=lowpass,
-            clip_low=clip[0], clip_high=clip[1])
-        if rate_known:
-            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
-    except ValueError as exc:
-        raise _setting_error(exc) from None
+    k_on = _number("--k-on", args.k_on, "dimensionless")
+    k_off = _number("--k-off", args.k_off, "dimensionless")
     mass = _number("--mass", args.mass, "mass")
     diameter = _number("--diameter", args.diameter, "length")
     poisson = _number("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
+    try:
+        settings = DetectorSettings(k_on=k_on, k_off=k_off, hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,),
+                                    lowpass_cutoff=lowpass, clip_low=clip[0], clip_high=clip[1])
+        if rate_known:
+            from fruitimpact.signals.detect import Detector
+
+            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
+    except ValueError as exc:
+        raise _setting_error(exc) from None
     classes = None
     if args.sort_by or args.thresholds:
         if not (args.sort_by and args.thresholds):
@@ -112,18 +113,20 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         names = tuple(args.classes.split(",")) if args.classes else \
             (("soft", "medium", "firm", "very-firm", "hard", "very-hard")[:len(thresholds) + 1]
              if len(thresholds) < 6 else tuple(f"class{k}" for k in range(len(thresholds) + 1)))
+        from fruitimpact.signals.sort import FirmnessClasses
+
         try:
             classes = FirmnessClasses(args.sort_by, thresholds, names)
         except ValueError as exc:
             raise InputError(f"argument --sort-by/--thresholds: {exc}") from None
+    from fruitimpact.signals.analysis import Analysis
+
     try:
         analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,
                             poisson=poisson, classes=classes, max_flight=window, pitch=pitch)
     except ValueError as exc:
         raise _setting_error(exc) from None
     return settings, analysis
-
-
 
 
 class _Options(dict):
