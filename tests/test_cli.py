@@ -471,7 +471,7 @@ def test_sigint_to_the_console_script_never_shows_a_traceback(delay):
         assert err.strip().endswith("interrupted") and len(err.strip().splitlines()) == 1
 
 
-def test_an_interrupt_swallowed_by_a_c_callback_is_delivered_again():
+def test_an_interrupt_swallowed_by_a_c_callback_is_delivered_again(monkeypatch):
     """Python reports a KeyboardInterrupt raised inside a ctypes callback (numba's LLVM object cache, seen on
     CI when Ctrl-C hit the first compilation) as "Exception ignored" and goes on; the console script's hook
     must deliver it again in Python code, so that the user's Ctrl-C is obeyed with its one line."""
@@ -483,6 +483,7 @@ def test_an_interrupt_swallowed_by_a_c_callback_is_delivered_again():
     import fruitimpact.cli as package
 
     saved_hook, saved_alarm = sys.unraisablehook, signal.getsignal(signal.SIGALRM)
+    monkeypatch.setattr(package, "_SWALLOWED", [])  # this process's record stays clean for later tests
     try:
         package._redeliver_interrupts_from_callbacks()
         sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=KeyboardInterrupt(),
@@ -561,3 +562,32 @@ def test_the_default_table_choice_is_the_whole_groups(monkeypatch):
     default = module.evaluate({"drop_height": heights, "fruit": "apple"})
     table = module.evaluate({"drop_height": heights, "fruit": "apple"}, tabulated=True)
     np.testing.assert_array_equal(default["peak_force"].to_numpy(), table["peak_force"].to_numpy())
+
+
+def test_a_failure_caused_by_a_swallowed_ctrl_c_is_answered_as_the_interrupt(monkeypatch, capsys):
+    """Seen on CI with a cold numba cache: a Ctrl-C swallowed in numba's object-cache callback leaves the compiler
+    without its object, and it raises "RuntimeError: no compiled object yet" before the interrupt can be
+    delivered again.  That failure is the interrupt's: one line, exit 130, no traceback."""
+    import signal
+    import sys
+    import types
+
+    import fruitimpact.cli as package
+
+    def compile_interrupted():
+        sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=KeyboardInterrupt(),
+                                                 exc_traceback=None, err_msg=None, object="callback"))
+        raise RuntimeError("no compiled object yet for <Library '_kernel'>")
+
+    saved_hook, saved_alarm = sys.unraisablehook, signal.getsignal(signal.SIGALRM)
+    monkeypatch.setattr(package, "build_parser", compile_interrupted)
+    monkeypatch.setattr(package, "_SWALLOWED", [])
+    monkeypatch.setattr(sys, "argv", ["fruitimpact", "line", "examples/line.csv"])
+    try:
+        status = package.main()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        sys.unraisablehook = saved_hook
+        signal.signal(signal.SIGALRM, saved_alarm)
+    out, err = capsys.readouterr()
+    assert status == 130 and err == "fruitimpact line: interrupted\n" and out == ""

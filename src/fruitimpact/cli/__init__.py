@@ -37,6 +37,12 @@ def _command(argv) -> str | None:
     return next((token for token in argv if token in COMMANDS), None)
 
 
+#: Callbacks in which a Ctrl-C was swallowed.  numba's compiler then fails on its own (a cache that never
+#: received its object: "RuntimeError: no compiled object yet"), before the interrupt is delivered again;
+#: that failure is the interrupt's, and is answered as one.
+_SWALLOWED: list = []
+
+
 def _redeliver_interrupts_from_callbacks() -> None:
     """A Ctrl-C that lands inside a C callback (numba's LLVM object cache notifies Python through ctypes)
     cannot propagate: Python prints "Exception ignored ... Traceback ... KeyboardInterrupt" and goes on.
@@ -54,6 +60,7 @@ def _redeliver_interrupts_from_callbacks() -> None:
 
     def hook(unraisable):
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            _SWALLOWED.append(unraisable.object)
             signal.signal(signal.SIGALRM, interrupt)
             signal.setitimer(signal.ITIMER_REAL, 0.005)
             return
@@ -95,11 +102,20 @@ def main(argv=None) -> int:
             print(f"{prefix}: error: {exc}", file=sys.stderr)
             return 2
     except KeyboardInterrupt:
+        if console:
+            _cancel_redelivery()  # first: a pending redelivery must not interrupt this answer
         command = _command(argv)
         print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # e.g. piped into head
         return 0
+    except Exception:
+        if not _SWALLOWED:
+            raise
+        _cancel_redelivery()
+        command = _command(argv)  # a failure caused by a Ctrl-C swallowed in a C callback
+        print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
+        return 130
     finally:
         if console:
             _cancel_redelivery()
