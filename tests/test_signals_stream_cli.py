@@ -21,16 +21,16 @@ def _reports(text: str) -> list[dict]:
 def test_stream_in_random_chunks_equals_analyze(cli, tmp_path, monkeypatch):
     """analyze reads the file in chunks (here of 7,919 samples, cutting contacts apart) through the same
     detector and analysis as stream: the same JSON objects, whatever the chunk and read sizes."""
-    from fruitimpact.cli import signals as signals_cli
+    from fruitimpact.signals import offline
 
     recording = tmp_path / "line.f32"
     cli.ok("synth", "-o", recording, "--count", "12", "--lanes", "2", "--seed", "5")
-    monkeypatch.setattr(signals_cli, "ANALYZE_CHUNK", 7919)
+    monkeypatch.setattr(offline, "ANALYZE_CHUNK", 7919)
     status, out, err = cli.run("analyze", recording, "--rate", "20000", "--lanes", "2", "--fit", "--drop-height",
                                "5cm", "--json")
     assert status == 0, err
     expected = _reports(out)
-    monkeypatch.setattr(signals_cli, "ANALYZE_CHUNK", 1 << 18)
+    monkeypatch.setattr(offline, "ANALYZE_CHUNK", 1 << 18)
     status, whole, err = cli.run("analyze", recording, "--rate", "20000", "--lanes", "2", "--fit", "--drop-height",
                                  "5cm", "--json")
     assert status == 0, err

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 import sys
 
+from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs,
+                                    add_spread_option, dump_json, print_spreads)
 from fruitimpact.impact.quantities import INPUTS, OUTPUTS
-from fruitimpact.impact.registries import REGISTRIES as REGISTRY_INPUTS
-from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, add_spread_option,
-                     dump_json, lot_distributions, print_spreads)
+
 
 def _without_velocity(args) -> dict:
     kwargs = _simulate_kwargs(args)

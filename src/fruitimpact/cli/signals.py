@@ -60,8 +60,6 @@ def analysis_from(args, rate: float, rate_known: bool = True):
 
 
 # ------------------------------------------------------------------------------------------- analyze
-#: Samples per lane read and analysed at once by ``analyze`` (memory is bounded by this, not the file).
-ANALYZE_CHUNK = 1 << 18
 
 
 def _table_header(analysis) -> str:
@@ -124,6 +122,7 @@ def cmd_analyze(args) -> int:
             raise UsageError(str(exc)) from None
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
+    from fruitimpact.signals import offline
     from fruitimpact.signals.analysis import public
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.stream import StreamAnalyzer
@@ -153,7 +152,7 @@ def cmd_analyze(args) -> int:
     done = 0
     with _sigterm_as_interrupt():
         try:
-            for chunk in source.chunks(ANALYZE_CHUNK):
+            for chunk in source.chunks(offline.ANALYZE_CHUNK):  # the API's chunk: the same memory bound
                 analyzer.feed(chunk)
                 done += chunk.shape[0]
                 if progress is not None:

@@ -42,10 +42,12 @@ _EXPORTS = {
     "merge_parts": "fruitimpact.runs.driver", "read_column": "fruitimpact.runs.driver",
     "RunSummary": "fruitimpact.runs.summaries",
     **{name: "fruitimpact.runs.plan" for name in (
-        "BLOCK_ROWS", "CHUNK_ROWS", "MAX_AXIS_VALUES", "MAX_CHUNK_ROWS", "MAX_ROWS", "MAX_SAMPLE_ROWS",
+        "CHUNK_ROWS", "MAX_AXIS_VALUES", "MAX_CHUNK_ROWS", "MAX_ROWS", "MAX_SAMPLE_ROWS",
         "PERCENTILES", "SAMPLE_ROWS", "Plan", "RunError", "Threshold", "characteristic", "characteristics_list")},
     **{name: "fruitimpact.runs.sources" for name in (
-        "Axis", "GridSource", "PopulationSource", "TableSource", "parse_axis", "table_format")},
+        "Axis", "GridSource", "TableSource", "parse_axis", "table_format")},
+    # a lot is drawn the same way by a population run and a line audit: it lives with the impacts
+    "BLOCK_ROWS": "fruitimpact.impact.lots", "PopulationSource": "fruitimpact.impact.lots",
 }
 
 

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fruitimpact.impact.lots import BLOCK_ROWS  # noqa: F401 (a limit of a run, defined with the lot)
 from fruitimpact.impact.quantities import CHARACTERISTICS, Quantity
 
 #: Rows per chunk by default: large enough that the per-chunk overhead is small next to evaluation.

@@ -24,7 +24,6 @@ import numpy as np
 from fruitimpact.impact.outputs import TABLE_FORMATS
 from fruitimpact.impact.quantities import INPUTS
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.lots import KEY_STREAM, PopulationSource, stream_number  # noqa: F401 (a run's population source)
 from fruitimpact.runs.plan import MAX_AXIS_VALUES, check_count
 
 #: Bytes of a CSV file parsed at a time.

@@ -7,7 +7,6 @@ a way to read the samples again and again, block by block, in memory bounded by 
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
