@@ -94,3 +94,34 @@ def test_text_with_another_count_of_numbers_than_lanes_is_refused_early():
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 2, result.stderr
     assert "--lanes" in result.stderr and len(result.stderr.strip().splitlines()) == 1
+
+
+def test_sigterm_mid_file_ends_analyze_with_whole_lines_only(tmp_path):
+    """A real SIGTERM to `analyze` half-way through a long file: the chunk in flight finishes (a detector update
+    is never cut), the contacts in progress are reported, every line written is a whole JSON object, and the
+    command ends with one "interrupted" line, exit 130 (the shared loop, signals.offline.feed_all)."""
+    import signal
+    import time
+
+    import fruitimpact as fi
+
+    rate = 20_000.0
+    curves = fi.simulate(fruit="apple", drop_height="4cm").curves
+    pulse = np.interp(np.arange(0.0, curves.time[-1], 1 / rate), curves.time, curves.force)
+    period = np.zeros(int(0.1 * rate))
+    period[200:200 + pulse.size] = pulse
+    force = np.tile(period, 6000) + np.random.default_rng(1).normal(0.0, 0.05, period.size * 6000)  # 600 s
+    path = tmp_path / "long.f32"
+    force.astype("<f4").tofile(path)
+    process = subprocess.Popen([console_script(), "analyze", str(path), "--rate", "20000", "--fit", "--drop-height",
+                                "4cm", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(8.0)
+    assert process.poll() is None, process.communicate()
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 130, (process.returncode, err)
+    assert err.splitlines()[-1] == "fruitimpact analyze: interrupted" and "Traceback" not in err, err
+    lines = out.splitlines()
+    assert len(lines) < 6000  # stopped early
+    for line in lines:
+        json.loads(line)  # whole objects only

@@ -9,7 +9,6 @@ import sys
 
 from fruitimpact.cli.common import PROG, UsageError, _library_call, dump_json
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.signals.settings import MAX_RATE
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
@@ -17,6 +16,16 @@ def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: b
     from fruitimpact.signals.options import _number
 
     return _library_call(_number, option, text, dimension, low, low_inclusive, high)
+
+
+def _rate(text):
+    """``--rate`` [Hz]: ``signals.settings.check_rate``, the one check of a sample rate (None when not given)."""
+    from fruitimpact.signals.settings import check_rate
+
+    try:
+        return check_rate(text)
+    except ValueError as exc:
+        raise UsageError(f"argument --rate: {exc}") from None
 
 
 def _json_line(obj) -> str:
@@ -109,7 +118,7 @@ class _Progress:
 
 
 def cmd_analyze(args) -> int:
-    rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
+    rate = _rate(args.rate)
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
     if lanes is None:
         raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
@@ -149,25 +158,23 @@ def cmd_analyze(args) -> int:
               + (" (fitted)" if analysis.fit else ""))
         print(_table_header(analysis))
     progress = _Progress(source.samples, source.rate) if args.progress else None
-    done = 0
-    with _sigterm_as_interrupt():
-        try:
-            for chunk in source.chunks(offline.ANALYZE_CHUNK):  # the API's chunk: the same memory bound
-                analyzer.feed(chunk)
-                done += chunk.shape[0]
-                if progress is not None:
-                    progress.update(done, analyzer.impacts)
-        except ValueError as exc:  # a bad row found mid-file: the samples before its block stand
-            analyzer.close()  # contacts in progress there are reported as truncated
-            if progress is not None:
-                progress.update(done, analyzer.impacts, final=True)
-            sys.stdout.flush()
-            raise UsageError(_reading_error(exc, args)) from None
-        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: what is known is written, then "interrupted"
-            analyzer.close()
-            sys.stdout.flush()
-            raise
-        analyzer.close()
+    fed = [0]  # samples fed so far, for the progress line of a file that fails mid-way
+
+    def on_chunk(done, count):
+        fed[0] = done
+        if progress is not None:
+            progress.update(done, count)
+
+    try:  # Ctrl-C or SIGTERM: what is known is written (the contacts in progress, truncated), then "interrupted"
+        done = offline.feed_all(analyzer, source.chunks(offline.ANALYZE_CHUNK), on_chunk)
+    except ValueError as exc:  # a bad row found mid-file: the samples before its block stand
+        if progress is not None:
+            progress.update(fed[0], analyzer.impacts, final=True)
+        sys.stdout.flush()
+        raise UsageError(_reading_error(exc, args)) from None
+    except KeyboardInterrupt:
+        sys.stdout.flush()
+        raise
     if progress is not None:
         progress.update(done, analyzer.impacts, final=True)
     if not args.json:
@@ -182,30 +189,6 @@ def cmd_analyze(args) -> int:
         if not args.json:
             print(f"figure written to {args.plot}")
     return 0
-
-
-class _sigterm_as_interrupt:
-    """While active (main thread): SIGTERM ends the command like Ctrl-C (the held contacts are flushed and
-    the lines written, exit 130), instead of killing it with its output half written."""
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        self._previous = None
-        if threading.current_thread() is threading.main_thread():
-            def interrupt(signum, frame):
-                raise KeyboardInterrupt
-
-            self._previous = signal.signal(signal.SIGTERM, interrupt)
-        return self
-
-    def __exit__(self, *exc):
-        import signal
-
-        if self._previous is not None:
-            signal.signal(signal.SIGTERM, self._previous)
-        return False
 
 
 def _reading_error(exc: ValueError, args) -> str:
@@ -333,7 +316,7 @@ def cmd_synth(args) -> int:
     if args.restitution is not None and args.alpha is not None:
         raise UsageError("give either --restitution or --alpha, not both")
     sensor_kwargs = dict(
-        rate=_float("--rate", args.rate, "frequency", high=MAX_RATE),
+        rate=_rate(args.rate),
         noise=_float("--noise", args.noise, "dimensionless", low_inclusive=True, high=1.0),
         drift=_float("--drift", args.drift, "dimensionless", low=-math.inf),
         hum_amplitude=_float("--hum", args.hum, "force", low_inclusive=True),
@@ -412,7 +395,7 @@ def add_synth_parser(sub) -> None:
 
 # -------------------------------------------------------------------------------------------- stream
 def cmd_stream(args) -> int:
-    rate = _float("--rate", args.rate, "frequency", high=MAX_RATE)
+    rate = _rate(args.rate)
     if rate is None:
         raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
     if not (str(args.lanes).isdigit() and 1 <= int(args.lanes) <= 256):

@@ -285,15 +285,19 @@ class LineAnalyzer:
                       f"above the lane's {lane_e:.2f}"}
 
 
-_WARM: set = set()
+#: Rate [Hz] of the warm-up's synthetic contacts.  What it prepares (the pulse tables, numba's compiled code) is
+#: the same for every rate, and its cost grows with the rate (13 s at 10 MHz), so it runs once, at this rate.
+WARM_RATE = 20_000.0
+_WARM: list = []
 
 
 def _warm_up(analysis: Analysis) -> None:
     """Build the pulse tables and load every compiled function a contact's report uses (~0.1–0.5 s once per
-    process and rate), by analysing a synthetic apple impact and a pair of them: a stream's first fruit then
-    costs what the others cost (without it the first report took 46–71 ms, benchmarks/latency.py)."""
-    if analysis.rate in _WARM:
+    process), by analysing a synthetic apple impact and a pair of them at ``WARM_RATE``: a stream's first fruit
+    then costs what the others cost (without it the first report took 46–71 ms, benchmarks/latency.py)."""
+    if _WARM:
         return
+    analysis = dataclasses.replace(analysis, rate=WARM_RATE)
     from fruitimpact.engine.powerlaw import exact_x, powerlaw_characteristics, powerlaw_curves
     from fruitimpact.signals.fit import at_velocity, prepare
 
@@ -323,7 +327,7 @@ def _warm_up(analysis: Analysis) -> None:
         if fit.get("converged") and fit.get("velocity_stderr") == 0.0:
             at_velocity(fit, 1.0)
         split_contact(t, window, 0.01, velocity=1.0)
-    _WARM.add(analysis.rate)
+    _WARM.append(True)
 
 
 def isolated(impact: DetectedImpact) -> DetectedImpact:

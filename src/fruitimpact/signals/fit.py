@@ -492,28 +492,13 @@ def _empty_result(message: str) -> dict:
 # ---------------------------------------------------------------------------------------------------------
 # Public API
 
-#: The dimension of each physical argument of the fit, for values given with a unit ("1 m/s", "150g").
-_DIMENSIONS = {"velocity": "velocity", "mass": "mass", "diameter": "length", "poisson": "dimensionless"}
-
-
-def _number(name, value) -> float:
-    """``value`` [SI] of argument ``name``: a number, or a string with a unit; ValueError naming it otherwise."""
-    from fruitimpact.impact.units import parse_quantity
-
-    try:
-        if isinstance(value, str):
-            return parse_quantity(value, _DIMENSIONS.get(name, "dimensionless"))
-        if isinstance(value, bool):
-            raise TypeError
-        return float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number (or a string with a unit); got {value!r}") from None
-
-
 def _positive(name, value):
+    """Argument ``name`` [SI] (a number, or a string with a unit: ``impact.validation.read_value``) > 0."""
+    from fruitimpact.impact.validation import read_value
+
     if value is None:
         return None
-    value = _number(name, value)
+    value = read_value(name, value)
     if not (math.isfinite(value) and value > 0.0):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return value
@@ -601,7 +586,9 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
         raise ValueError("give diameter and poisson together (the modulus needs both)")
     diameter = _positive("diameter", diameter)
     if poisson is not None:
-        poisson = _number("poisson", poisson)
+        from fruitimpact.impact.validation import read_value
+
+        poisson = read_value("poisson", poisson)
         if not (0.0 <= poisson < 0.5):
             raise ValueError(f"poisson must be in [0, 0.5), got {poisson!r}")
     t = np.asarray(time, dtype=float)

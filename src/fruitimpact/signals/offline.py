@@ -65,15 +65,17 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     import pandas as pd
 
     from fruitimpact.impact.validation import InputError, check_integer
-    from fruitimpact.signals.analysis import public
-    from fruitimpact.signals.options import _number, analysis_settings
+    from fruitimpact.signals.analysis import FIT_KEYS, REPORT_KEYS, public
+    from fruitimpact.signals.indices import INDEX_KEYS
+    from fruitimpact.signals.options import analysis_settings
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.recording import Recording
-    from fruitimpact.signals.settings import MAX_RATE
+    from fruitimpact.signals.read.common import RATE_TOLERANCE
+    from fruitimpact.signals.settings import check_rate
     from fruitimpact.signals.stream import StreamAnalyzer
 
     lanes = check_integer("lanes", lanes, 1)
-    rate_value = None if rate is None else _number("--rate", rate, "frequency", high=MAX_RATE)
+    rate_value = check_rate(rate)
     analysis_settings(rate_value if rate_value is not None else 1e12, rate_value is not None, **options)
     from_file = isinstance(source, (str, bytes)) or hasattr(source, "__fspath__")
     if not from_file:
@@ -81,9 +83,9 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
             if value != default:
                 raise InputError(f"{name} applies to a recording file; the samples given are already lanes", name)
     if isinstance(source, Recording):
-        if rate_value is not None and abs(rate_value - source.rate) > 1e-6 * source.rate:
-            raise InputError(f"argument --rate: {rate_value:g} Hz disagrees with the recording's {source.rate:g} Hz "
-                             f"(leave it out)", "rate")
+        if rate_value is not None and abs(rate_value - source.rate) > RATE_TOLERANCE * source.rate:
+            raise InputError(f"rate {rate_value:g} Hz disagrees with the recording's {source.rate:g} Hz (leave it "
+                             f"out)", "rate")
         names, start, chunks, rate_value = list(source.lanes), source.start_time, None, source.rate
         samples = np.column_stack([source.lanes[name] for name in names])
     elif from_file:
@@ -92,7 +94,7 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
         chunks = reader.chunks(ANALYZE_CHUNK)
     else:
         if rate_value is None:
-            raise InputError("argument --rate: required for an array of samples (the sample rate [Hz])", "rate")
+            raise InputError("rate is required for an array of samples (the sample rate [Hz])", "rate")
         try:
             samples = np.asarray(source, dtype=float)
         except (TypeError, ValueError):
@@ -111,7 +113,41 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     analyzer = StreamAnalyzer(rate_value, len(names), settings, lambda report: None,
                               on_detected=lambda impact, report: rows.append(public(report)), analysis=analysis,
                               lane_names=names, start_time=start)
-    for chunk in chunks:
-        analyzer.feed(chunk)
-    analyzer.close()
+    feed_all(analyzer, chunks)
+    if not rows:  # a quiet recording: no contact, but the columns a caller selects are there
+        return pd.DataFrame(columns=[*INDEX_KEYS, *REPORT_KEYS, *(FIT_KEYS if analysis.fit else ())])
     return pd.DataFrame(rows)
+
+
+def feed_all(analyzer, chunks, on_chunk=None) -> int:
+    """Feed every chunk of samples to a :class:`~fruitimpact.signals.stream.StreamAnalyzer`, then close it;
+    returns the samples fed per lane.  The one loop of ``analyze`` (CLI and API).
+
+    SIGINT and SIGTERM (main thread) wait for the chunk in flight, so a detector update is never cut; then, as
+    on a bad row of the file (``ValueError``), the analyzer is closed first (the contacts in progress are
+    reported, marked truncated) and the interruption (``KeyboardInterrupt``) or the error is raised.
+    ``on_chunk(samples_fed, impacts_reported)`` is called after each chunk (progress)."""
+    from fruitimpact.signals.stream import _Interrupted, _SignalGuard
+
+    done = 0
+    with _SignalGuard() as guard:
+        try:
+            for chunk in chunks:
+                with guard.section():
+                    analyzer.feed(chunk)
+                done += chunk.shape[0]
+                if on_chunk is not None:
+                    on_chunk(done, analyzer.impacts)
+                if guard.pending is not None:
+                    raise _Interrupted(guard.pending)
+        except _Interrupted:
+            with guard.section():
+                analyzer.close()
+            raise KeyboardInterrupt from None
+        except BaseException:  # a bad row mid-file, or an interruption from elsewhere
+            with guard.section():
+                analyzer.close()
+            raise
+        with guard.section():
+            analyzer.close()
+    return done

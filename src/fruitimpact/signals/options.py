@@ -58,7 +58,8 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         raise InputError(f"argument --fit: fit must be True or False; got {options['fit']!r}")
     # the Python API may give a sequence where the CLI gives "A,B"
     options = {name: ",".join(str(v) for v in value) if name in ("clip", "thresholds", "classes")
-               and isinstance(value, (list, tuple)) else value for name, value in options.items()}
+               and not isinstance(value, (str, bytes)) and hasattr(value, "__iter__") else value
+               for name, value in options.items()}
     args = _Options({**ANALYSIS_DEFAULTS, **{k: v for k, v in options.items() if v is not None}})
     from fruitimpact.physics.constants import STANDARD_GRAVITY
     from fruitimpact.signals.settings import DetectorSettings
@@ -103,6 +104,8 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     except ValueError as exc:
         raise _setting_error(exc) from None
     classes = None
+    if args.classes and not (args.sort_by or args.thresholds):
+        raise InputError("argument --classes: names the classes of --sort-by INDEX --thresholds A,B,...: give them too")
     if args.sort_by or args.thresholds:
         if not (args.sort_by and args.thresholds):
             raise InputError("argument --thresholds: give --sort-by INDEX and --thresholds A,B,... together")
