@@ -219,3 +219,30 @@ def test_unit_strings_are_read_where_the_cli_reads_them(recording):
     assert fi.read_recording(path, rate="20kHz").rate == pytest.approx(rate)
     by_units = fi.analyze(force, rate="20kHz", clip=("-1kN", "2kN"), thresholds=[1e7], sort_by="firmness_c_star")
     assert len(by_units) == 2
+
+
+def test_safe_height_risk_map_and_line_pass_on_the_evaluations_warnings(cli):
+    """A pear has no restitution of its own: the paper's 0.577 is used, and every command must say so (the
+    review of the change found safe-height, the risk map and the line audit silent about it)."""
+    given = dict(fruit="pear", criterion="shear", failure_stress="0.3MPa")
+    borrowed = "restitution is not in the pear entry"
+    assert any(borrowed in w for w in fi.safe_height(**given)["warnings"])
+    assert any(borrowed in w for w in fi.risk_map(by="surface", **given)["warnings"])
+    assert any(borrowed in w for w in fi.audit_line("examples/line.csv", rows=50, **given)["warnings"])
+    report = cli.json("safe-height", "--fruit", "pear", "--criterion", "shear", "--failure-stress", "0.3MPa")
+    assert any(borrowed in w for w in report["warnings"])
+
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: fi.risk_map(by="surface", fruit="apple", surface_modulus=1e6), "surface_modulus is what the risk map"),
+    (lambda: fi.risk_map(by="firmness", fruit="apple", stiffness=8e5), "stiffness is what the risk map"),
+    (lambda: fi.audit_line("examples/line.csv", rows=10, fruit="apple", surface_model="half-space"),
+     "surface_model is set by each transfer point"),
+    (lambda: fi.safe_height(fruit="banana"), "fruit must be one of"),
+    (lambda: fi.drop("30cm", fruit="apple", max_impacts=True), "max_impacts must be an integer"),
+])
+def test_inputs_that_would_override_a_map_or_a_line_are_refused(call, match):
+    """A surface input given to a map across surfaces (or to a line, whose points name their surfaces) would
+    silently replace the value each column or point names; a misspelt fruit is named as such."""
+    with pytest.raises(ValueError, match=match):
+        call()

@@ -94,6 +94,7 @@ def cmd_safe_height(args) -> int:
         key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows",
                                                                      "safe_height"))
         report["risk_map"] = {"by": key, "safe_height": safe}
+        report["warnings"] += [text for text in risk["warnings"] if text not in report["warnings"]]
         if args.map_csv:
             from fruitimpact.impact.outputs import atomic_write
 
@@ -112,6 +113,7 @@ def cmd_safe_height(args) -> int:
 
             _library_call(save_figure, risk_map_figure(key, columns, heights, rows, safe, report["criterion"]),
                           args.plot, "--plot")
+    _print_warnings("safe-height", report["warnings"])
     height = report["safe_height"]
     report["status"] = "ok" if not math.isnan(height) else "failed"
     if args.json:

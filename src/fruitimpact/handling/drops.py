@@ -105,10 +105,8 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     reaction to impact of apples on rigid plane surfaces"); plastic reloading after C. Thornton, J. Appl. Mech.
     64 (1997) 383–386; bounce rule: docs/damage.md.
     """
-    from fruitimpact.impact.evaluation import evaluate_inputs
-    from fruitimpact.impact.inputs import read_columns
     from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.validation import InputError, check_number
+    from fruitimpact.impact.validation import InputError, check_integer, check_number
 
     for name in ("velocity", "drop_height"):
         if name in inputs:
@@ -123,11 +121,14 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
                          "alpha or damping the law sets e at each speed, which is bounces material)", "bounces")
     rest_height = check_number("rest_height", rest_height, low=0.0, low_inclusive=False, high=1.0,
                                high_inclusive=True)
-    if not (isinstance(max_impacts, int) and 1 <= max_impacts <= 1000):
-        raise InputError(f"max_impacts must be an integer in [1, 1000]; got {max_impacts!r}", "max_impacts")
+    max_impacts = check_integer("max_impacts", max_impacts, 1, 1000)
     if inputs.get("surface") == "fruit":
         raise InputError("surface fruit is a free partner: a drop bounces on a fixed surface (simulate the "
                          "fruit-on-fruit impact itself with --surface fruit)", "surface")
+    # the engine only now: every argument above is answered without it
+    from fruitimpact.impact.evaluation import evaluate_inputs
+    from fruitimpact.impact.inputs import read_columns
+
     row = {name: value for name, value in inputs.items() if value is not None}
     row["drop_height"] = drop_height
     read, messages = read_columns({name: [value] for name, value in row.items()})

@@ -90,16 +90,18 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
     return heights, messages
 
 
-def _checked_inputs(inputs: dict, finder: str, mapped: str | None = None) -> dict:
-    """The inputs of one safe-height question, checked as one row before any work (the same checks for
-    :func:`safe_height` and :func:`risk_map`): no velocity or drop height (``finder`` finds it) nor the
-    ``mapped`` input, no unknown input, a criterion (the fruit's own when none is given, issue 14 item 5c)."""
+def _checked_inputs(inputs: dict, finder: str, axis: tuple[str, ...] = ()):
+    """(inputs, probe) of one safe-height question, checked as one row before any work (the same checks for
+    :func:`safe_height` and :func:`risk_map`): no velocity or drop height (``finder`` finds it) nor an input
+    of the map's ``axis`` (it would override the value each column names), no unknown input, a criterion (the
+    fruit's own when none is given, issue 14 item 5c).  ``probe`` is the row's evaluation at 1 cm: its
+    warnings are the inputs' own."""
     from fruitimpact.impact.presets import fruit_criterion
     from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.validation import InputError
 
-    for name in ("velocity", "drop_height", mapped):
-        if name is not None and inputs.get(name) is not None:
+    for name in ("velocity", "drop_height", *axis):
+        if inputs.get(name) is not None:
             raise InputError(f"{name} is what {finder}: leave it out", name)
     unknown = [name for name in inputs if name not in INPUTS]
     if unknown:
@@ -110,8 +112,14 @@ def _checked_inputs(inputs: dict, finder: str, mapped: str | None = None) -> dic
                          "changes by an order of magnitude between them)", "criterion")
     inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), criterion)}
     given = {name: value for name, value in inputs.items() if value is not None}
-    _check_row(given)
-    return given
+    return given, _check_row(given)
+
+
+def _merged_warnings(result, what: str) -> list[str]:
+    """Each distinct warning of an evaluation once, with how many of its rows (``what``) carry it."""
+    rows = result.warnings.masks.size
+    return [f"{text} ({int(np.count_nonzero(result.warnings.masks >> bit & 1))} of {rows} {what})"
+            for bit, text in enumerate(result.warnings.texts)]
 
 
 def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
@@ -151,14 +159,11 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     Onset of bruising under the Hertz contact: K. L. Johnson, *Contact Mechanics* (1985) eq 3.45 and §11.4;
     the shear criterion after Yuwana & Duprat (1998); docs/bruise.md.
     """
-    given = _checked_inputs(inputs, "safe-height finds")
+    given, base = _checked_inputs(inputs, "safe-height finds")
     criterion = given["criterion"]
     names = SENSITIVITY_INPUTS.get(criterion, ())
     cases = [given]
     if sensitivity:
-        from fruitimpact.impact.evaluation import evaluation
-
-        base = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
         for name in names:
             value = float(base.columns[name][0])
             for factor in (1.0 + SENSITIVITY_STEP, 1.0 - SENSITIVITY_STEP):
@@ -167,7 +172,8 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     heights, messages = safe_heights(table, len(cases))
     height = float(heights[0])
     report = {"safe_height": height, "safe_velocity": math.sqrt(2.0 * STANDARD_GRAVITY * height)
-              if math.isfinite(height) else height, "criterion": criterion, "message": messages[0]}
+              if math.isfinite(height) else height, "criterion": criterion, "message": messages[0],
+              "warnings": base.warnings.row(0)}
     if sensitivity:
         report["sensitivity"] = {}
         for k, name in enumerate(names):
@@ -179,14 +185,15 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
         from fruitimpact.impact.evaluation import evaluation
 
         at = evaluation({name: [value] for name, value in {**given, "drop_height": height}.items()})
+        report["warnings"] += [text for text in at.warnings.row(0) if text not in report["warnings"]]
         for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy", "absorbed_energy",
                      "restitution", "failure_stress", "bruise_energy"):
             report[name] = float(at.columns[name][0])
     return report
 
 
-def _check_row(given: dict) -> None:
-    """Refuse bad inputs before the search, with the table's message."""
+def _check_row(given: dict):
+    """The row's evaluation at 1 cm; bad inputs refused before the search, with the table's message."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.status import INVALID
     from fruitimpact.impact.validation import InputError
@@ -194,6 +201,7 @@ def _check_row(given: dict) -> None:
     probe = evaluation({name: [value] for name, value in {**given, "drop_height": 0.01}.items()})
     if probe.status[0] == INVALID:
         raise InputError(probe.messages.text(0), probe.messages.argument(0))
+    return probe
 
 
 __all__ = ["HIGHEST", "LOWEST", "SENSITIVITY_INPUTS", "safe_height", "safe_heights"]
@@ -205,6 +213,10 @@ MAP_HEIGHTS = 30
 MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
 #: What a risk map can run across (the ``--map`` choices) → the input it varies.
 MAP_AXES = {"surface": "surface", "firmness": "modulus"}
+#: The inputs each axis sets: giving one would override the value a column names.
+AXIS_INPUTS = {"surface": ("surface", "surface_model", "surface_modulus", "surface_poisson", "surface_radius",
+                           "surface_thickness", "surface_crush_stress", "partner_mass"),
+               "modulus": ("modulus", "stiffness")}
 
 
 def risk_map(*, by: str = "surface", **inputs) -> dict:
@@ -252,7 +264,7 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     if by not in MAP_AXES:
         raise InputError(f"by must be one of {', '.join(MAP_AXES)}; got {by!r}", "map")
     key = MAP_AXES[by]
-    base = _checked_inputs(inputs, "the risk map spans", mapped=key)
+    base, _ = _checked_inputs(inputs, "the risk map spans", axis=AXIS_INPUTS[key])
     heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
     columns = [name for name in SURFACE_CHOICES if name != "rigid"] if key == "surface" else list(MAP_MODULI)
     by = key
@@ -271,4 +283,5 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     safe_table[by] = columns
     safe, _ = safe_heights(safe_table, len(columns))
     return {"by": by, "columns": columns, "heights": heights, "rows": rows,
+            "warnings": _merged_warnings(result, "grid points"),
             "safe_height": {str(c): float(h) for c, h in zip(columns, safe)}}

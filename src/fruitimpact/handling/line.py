@@ -40,10 +40,9 @@ class TransferPoint:
 
 def _points(line) -> list[TransferPoint]:
     """The transfer points of ``line``: a line file (a path) read by :func:`read_line`, or a non-empty sequence of
-    :class:`TransferPoint` with heights [m] > 0 and library surfaces; ``InputError`` naming ``line`` otherwise."""
+    :class:`TransferPoint`, each checked as a file's row is (``_checked_point``); ``InputError`` naming ``line``."""
     import os
 
-    from fruitimpact.impact.registries import SURFACE_CHOICES
     from fruitimpact.impact.validation import InputError
 
     if isinstance(line, (str, os.PathLike)):
@@ -51,15 +50,12 @@ def _points(line) -> list[TransferPoint]:
     if not isinstance(line, (list, tuple)) or not line or not all(isinstance(p, TransferPoint) for p in line):
         raise InputError("line must be a line CSV (a path) or a non-empty list of TransferPoint; got "
                          f"{type(line).__name__}", "line")
-    for point in line:
-        height = point.drop_height
-        if isinstance(height, bool) or not isinstance(height, (int, float)) or not 0.0 < height < math.inf:
-            raise InputError(f"transfer point {point.name!r}: drop_height must be a number of m > 0; got {height!r}",
-                             "line")
-        if point.surface not in SURFACE_CHOICES:
-            raise InputError(f"transfer point {point.name!r}: surface must be one of {', '.join(SURFACE_CHOICES)}; "
-                             f"got {point.surface!r}", "line")
-    return list(line)
+    if len(line) > MAX_POINTS:
+        raise InputError(f"line has {len(line)} transfer points; at most {MAX_POINTS}", "line")
+    try:
+        return [_checked_point(point, f"transfer point {point.name!r}") for point in line]
+    except ValueError as exc:
+        raise InputError(str(exc), "line") from None
 
 
 def read_line(path) -> list[TransferPoint]:
@@ -69,7 +65,6 @@ def read_line(path) -> list[TransferPoint]:
     import csv
     import os
 
-    from fruitimpact.impact.registries import SURFACE_CHOICES
     from fruitimpact.impact.units import parse_quantity
 
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
@@ -102,24 +97,33 @@ def read_line(path) -> list[TransferPoint]:
         if len(row) != len(header):
             raise ValueError(f"{where}: {len(row)} fields, the header has {len(header)}")
         cells = dict(zip(header, (cell.strip() for cell in row)))
-        if not cells["name"]:
-            raise ValueError(f"{where}: name is empty")
         try:
             height = parse_quantity(cells["drop_height"], "length")
         except ValueError as exc:
             raise ValueError(f"{where}: drop_height: {exc}") from None
-        if not (math.isfinite(height) and 0.0 < height <= 10.0):
-            raise ValueError(f"{where}: drop_height must be in (0, 10] m; got {cells['drop_height']!r}")
-        surface = cells["surface"]
-        if surface not in SURFACE_CHOICES or surface == "fruit":
-            raise ValueError(f"{where}: surface must be one of "
-                             f"{', '.join(s for s in SURFACE_CHOICES if s != 'fruit')}; got {surface!r} "
-                             f"(fruit on fruit: set fruit_on_fruit to true)")
         flag = cells.get("fruit_on_fruit", "").lower()
         if flag not in _TRUE | _FALSE:
             raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
-        points.append(TransferPoint(cells["name"], height, surface, flag in _TRUE))
+        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag in _TRUE), where))
     return points
+
+
+def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
+    """A transfer point as a line accepts it, whether read from a file or given in Python; ValueError
+    prefixed with ``where`` otherwise."""
+    from fruitimpact.impact.registries import SURFACE_CHOICES
+
+    if not isinstance(point.name, str) or not point.name:
+        raise ValueError(f"{where}: name must be a non-empty text; got {point.name!r}")
+    height = point.drop_height
+    if isinstance(height, bool) or not isinstance(height, (int, float)) or not 0.0 < height <= 10.0:
+        raise ValueError(f"{where}: drop_height must be in (0, 10] m; got {height!r}")
+    if point.surface not in SURFACE_CHOICES or point.surface == "fruit":
+        raise ValueError(f"{where}: surface must be one of {', '.join(s for s in SURFACE_CHOICES if s != 'fruit')}; "
+                         f"got {point.surface!r} (fruit on fruit: set fruit_on_fruit to true)")
+    if not isinstance(point.fruit_on_fruit, bool):
+        raise ValueError(f"{where}: fruit_on_fruit must be True or False; got {point.fruit_on_fruit!r}")
+    return point
 
 
 #: The surface tried in place of each transfer point's by default (``audit``'s ``alternatives``).
@@ -142,10 +146,9 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``changes`` lists, best first, each (point, surface) with the line's incidence and mean bruise volume
     with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
     difference)."""
-    from fruitimpact.impact.evaluation import evaluation
-    from fruitimpact.physics.constants import STANDARD_GRAVITY
-    from fruitimpact.library.catalogue import surfaces
     from fruitimpact.impact.validation import InputError
+    from fruitimpact.library.catalogue import surfaces
+    from fruitimpact.physics.constants import STANDARD_GRAVITY
 
     if isinstance(alternatives, str) or not all(isinstance(a, str) for a in alternatives):
         raise InputError("alternatives must be a sequence of library surface names", "alternatives")
@@ -155,12 +158,15 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         raise InputError(f"alternatives must be library surfaces ({', '.join(cushions)}); got {unknown[0]!r}",
                          "alternatives")
     alternatives = tuple(dict.fromkeys(alternatives))  # each once, in the order given
+    from fruitimpact.impact.evaluation import evaluation  # the engine only now: the arguments are answered without it
     bruised_any = np.zeros(rows, dtype=bool)
     volume_total = np.zeros(rows)
     valid_so_far = np.ones(rows, dtype=bool)  # fruit computed at every point so far: the cumulation's population
     report = []
     warnings = []
-    per_point = []  # (bruised, volume, ok) of each point, for the changes
+    noted: dict[str, list] = {}  # warning → [(transfer point, fruit)]
+    per_point = []  # (bruised, volume) of each point, for the changes
+    bruise_count = np.zeros(rows, dtype=np.int64)  # points where each fruit bruised
 
     def run(point, surface):
         table = {**members, **constants, "drop_height": np.full(rows, point.drop_height),
@@ -172,16 +178,21 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         status = result.status
         ok = status == 0
         if not ok.any() and (status == 3).all():
-            raise InputError(f"transfer point {point.name!r}: {result.messages.text(0)}",
-                             result.messages.argument(0))
+            argument = result.messages.argument(0)  # a point's own input, or one of the whole lot
+            where = f"transfer point {point.name!r}: " if argument in ("drop_height", "surface", "velocity") else ""
+            raise InputError(f"{where}{result.messages.text(0)}", argument)
         bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
         # a bruised fruit without a volume (no bruise susceptibility) leaves the mean volume unknown, never 0
         volume = np.where(bruised, result.columns["bruise_volume"], 0.0)
-        per_point.append((bruised, volume, ok))
+        per_point.append((bruised, volume))
+        bruise_count += bruised
         bruised_any |= bruised
         volume_total += volume
         valid_so_far &= ok
         count = max(int(ok.sum()), 1)
+        for bit, text in enumerate(result.warnings.texts):  # the inputs' and the impacts' own warnings
+            carrying = int(np.count_nonzero(result.warnings.masks >> bit & 1))
+            noted.setdefault(text, []).append((point.name, carrying))
         if not ok.all():
             first = int(np.flatnonzero(~ok)[0])
             warnings.append(f"transfer point {point.name!r}: {int((~ok).sum())} of {rows} fruit not computed "
@@ -200,14 +211,26 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             "cumulative_bruise_volume": float(volume_total[valid_so_far].sum() / kept),
             "invalid": int((status == 3).sum()), "failed": int((status == 2).sum()),
         })
+    for text, where in noted.items():  # each warning once, with where and for how many fruit
+        places = ", ".join(f"{name!r} ({count} of {rows})" for name, count in where)
+        warnings.append(f"{text} (at {places})" if len(where) < len(points) else
+                        f"{text} (at every transfer point, {max(c for _, c in where)} of {rows} fruit at most)")
     worst = max(range(len(report)), key=lambda i: (report[i]["incidence"], report[i]["mean_bruise_volume"]))
     kept = max(int(valid_so_far.sum()), 1)
     incidence = float(bruised_any[valid_so_far].sum() / kept)
     mean_volume = float(volume_total[valid_so_far].sum() / kept)
     changes = []
     for k, point in enumerate(points):
+        if point.fruit_on_fruit:
+            continue
+        # what the other points do to each fruit: the same for every alternative at this point
+        others_bruised = (bruise_count - per_point[k][0]) > 0
+        others_volume = np.zeros(rows)
+        for j, (_, v) in enumerate(per_point):
+            if j != k:
+                others_volume += v  # summed, not subtracted: a point's unknown (NaN) volume stays its own
         for surface in alternatives:
-            if point.fruit_on_fruit or surface == point.surface:
+            if surface == point.surface:
                 continue
             result = run(point, surface)
             ok = (result.status == 0) & valid_so_far
@@ -215,12 +238,6 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
                 continue
             bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]), 0.0) > 0.5
             volume = np.where(bruised, result.columns["bruise_volume"], 0.0)
-            others_bruised = np.zeros(rows, dtype=bool)
-            others_volume = np.zeros(rows)
-            for j, (b, v, _) in enumerate(per_point):
-                if j != k:
-                    others_bruised |= b
-                    others_volume += v
             changed = float((others_bruised | bruised)[ok].mean())
             changed_volume = float((others_volume + volume)[ok].mean())
             base = float(bruised_any[ok].mean())
@@ -294,6 +311,7 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
     The bruise criteria and volumes: :mod:`fruitimpact.damage.bruise` (docs/bruise.md); the lot spreads:
     docs/library.md.
     """
+    from fruitimpact.handling.heights import AXIS_INPUTS
     from fruitimpact.impact.distributions import parse_distribution
     from fruitimpact.impact.lots import PopulationSource
     from fruitimpact.impact.presets import fruit_criterion, lot_distributions
@@ -307,14 +325,14 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
     if criterion == "none":
         raise InputError("criterion must be given for a line audit: pressure, shear or energy (the onset height "
                          "changes by an order of magnitude between them)", "criterion")
-    criterion = fruit_criterion(inputs.get("fruit"), inputs.pop("criterion", criterion))
+    criterion = fruit_criterion(inputs.get("fruit"), criterion)
     distributions, constants = [], {}
     for name, spec in inputs.items():
         if name not in INPUTS:
             raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
         if spec is None:
             continue
-        if name in ("velocity", "drop_height", "surface"):
+        if name in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):  # would override every point's surface
             raise InputError(f"{name} is set by each transfer point of the line", name)
         quantity = INPUTS[name]
         if not quantity.numeric:

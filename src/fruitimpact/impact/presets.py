@@ -22,14 +22,10 @@ _FRUIT_KEYS = {"bruise_threshold_energy": "bruise_energy"}
 _LIBRARY_KEYS = {value: key for key, value in _FRUIT_KEYS.items()}
 #: Surface models as codes.
 HALF_SPACE, LAYER = 0, 1
-#: Defaults of the damage inputs of a row without a ``--fruit`` (the paper's apple, docs/damage.md).  A row with
-#: a ``--fruit`` takes its damage values from that fruit's library entry only: one fruit never borrows another's
-#: (issue 14 item 1); what the entry lacks is in ``Resolved.missing`` and the criterion needing it is refused.
-DAMAGE_DEFAULTS = {
-    "failure_stress": 0.32e6,  # apple flesh, Gorji Chakespari et al., Modern Applied Science (0.29-0.37 MPa)
-    "bruise_susceptibility": 4.66e-6,  # apples, five cultivars 3.71-6.23 cm³/J (Int. J. Biosystems Eng.)
-    "bruise_energy": 0.0,
-}
+#: The damage inputs a row takes from its fruit's library entry (every row has a fruit: the default one when
+#: none is given), and their value before it: unknown, never another fruit's (issue 14 item 1; what the entry
+#: lacks is in ``Resolved.missing`` and the criterion needing it is refused), but no threshold energy.
+DAMAGE_DEFAULTS = {"failure_stress": math.nan, "bruise_susceptibility": math.nan, "bruise_energy": 0.0}
 
 
 @dataclass
@@ -230,9 +226,11 @@ def fruit_criterion(fruit: str | None, criterion: str | None) -> str:
     ``criterion`` when that fruit has none (a command that needs a criterion refuses then)."""
     if criterion not in (None, "preset"):
         return criterion
-    name = fruit or INPUTS["fruit"].default
-    entry = library.fruits().get(name)
-    if entry is None or entry.criterion is None:
+    from fruitimpact.impact.validation import check_choice
+
+    name = check_choice("fruit", fruit or INPUTS["fruit"].default, library.fruits())  # a misspelt fruit is said so
+    entry = library.fruits()[name]
+    if entry.criterion is None:
         from fruitimpact.impact.validation import InputError
 
         raise InputError(f"criterion must be given: the {name} entry of the fruit library names no bruise criterion "
@@ -251,7 +249,7 @@ def effective_mass(mass, partner_mass):
 
 __all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
            "lot_spreads", "resolve"]
-assert all(name in INPUTS for name in DAMAGE_DEFAULTS) and math.isfinite(DAMAGE_DEFAULTS["failure_stress"])
+assert all(name in INPUTS for name in DAMAGE_DEFAULTS)
 
 
 def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: bool = True):
