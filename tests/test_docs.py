@@ -30,6 +30,14 @@ def test_the_docs_site_builds_strict_with_its_examples_run(tmp_path):
                  "handling.line.audit_line", "signals.offline.analyze", "signals.read.read_recording",
                  "signals.fit.fit_impact"):  # each rendered with its own anchor, from its docstring
         assert f'id="fruitimpact.{path}"' in api, path
+    # rendered for the theme (docs/hooks/rendering.py): an id starting with a digit stopped the theme's scripts
+    # on two pages, and Sphinx roles showed literally in the API reference
+    import re
+
+    for page in (tmp_path / "site").rglob("index.html"):
+        html = page.read_text()
+        assert not re.search(r'id="\d', html), page
+        assert not re.search(r":(?:func|mod|class):<code>", html), page
     # the examples ran: their printed output is on the page
     assert "safe height onto steel" in (tmp_path / "site" / "tasks" / "drops" / "index.html").read_text()
 

@@ -141,12 +141,13 @@ def open_recording(path, *, rate: float | None = None, column: str | None = None
         None), ``samples`` per lane (None for a CSV file longer than the rows
         that gave its rate), ``source`` = the path, and ``chunks(samples)``.
 
-    Raises ``ValueError`` (one line naming the file or the argument and what is
-    allowed) for a missing file, a folder, an unsupported format, garbage or
-    empty content, a missing ``rate``, an unknown ``column`` (the available ones
-    are listed), lanes without samples, and the errors of the header, units,
-    channels and properties described in the module docstring; the arguments
-    are checked before the file.
+    Raises
+    ------
+    ValueError
+        One line naming the file or the argument and what is allowed: a missing file, a folder, an unsupported
+        format, garbage or empty content, a missing ``rate``, an unknown ``column`` (the available ones are
+        listed), lanes without samples, and the errors of the header, units, channels and properties described
+        in the module docstring; the arguments are checked before the file.
     """
     rate = check_rate(rate)
     if column is not None and not isinstance(column, str):
@@ -177,34 +178,34 @@ def read_recording(path, *, rate: float | None = None, column: str | None = None
                    lanes: int = 1) -> Recording:
     """Read a whole force recording: ``open_recording`` with the same arguments, every chunk joined.
 
-    Returns
-    -------
-    Recording
-        Force [N] of every lane (float64), the rate [Hz], the start time [s],
-        the ADC limits [N] when the file states them, and ``source`` = the path.
-
-    Raises ``ValueError`` (one line) as ``open_recording`` and its ``chunks``
-    do.  Memory: the recording itself, two (three for CSV) times over while it is
-    built; use ``open_recording(...).chunks()`` for files larger than memory.
+    Memory: the recording itself, two (three for CSV) times over while it is built; use
+    ``open_recording(...).chunks()`` for files larger than memory.
 
     Parameters
     ----------
     path : str or Path
         The file (``.csv``/``.txt``, ``.npy``, ``.f32``/``.bin``/``.raw``, ``.tdms``).
-    rate, column, format, lanes
-        As for :func:`open_recording` (``rate`` [Hz]).
+    rate : float or str, optional
+        Sample rate [Hz] (or with a unit, ``"20kHz"``), as for ``open_recording``.
+    column : str, optional
+        Read only this lane, as for ``open_recording``.
+    format : str, optional
+        ``csv``, ``npy``, ``f32`` or ``tdms``; default from the extension.
+    lanes : int
+        Interleaved lanes of a raw float32 file.
 
     Returns
     -------
     Recording
-        Force [N] of each lane at ``rate`` [Hz], with its ``start_time`` [s] and clip limits when known.
+        Force [N] of every lane (float64), the rate [Hz], the start time [s], the ADC limits [N] when the file
+        states them, and ``source`` = the path.
 
     Raises
     ------
     ValueError
-        A file that cannot be read or is not a recording (a ragged row, a non-finite sample, no unit on the
-        time column), an unsupported format, a rate that is missing or disagrees with the file; the message
-        names the row or column.
+        As ``open_recording`` and its ``chunks`` (one line): a file that cannot be read or is not a recording (a
+        ragged row, a non-finite sample, no unit on the time column), an unsupported format, a rate that is
+        missing or disagrees with the file; the message names the row, column or argument.
 
     Examples
     --------
