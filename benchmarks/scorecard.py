@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import platform
 import subprocess
 import sys
 import tempfile
@@ -39,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import linegen as lg  # noqa: E402  (tests/linegen.py: the independent generator)
-from bench_common import console_script  # noqa: E402
+from bench_common import console_script, machine  # noqa: E402
 
 #: Columns: (header, key in the scorecard, format, goal key or None).
 COLUMNS = [
@@ -165,9 +164,7 @@ def main(argv=None) -> int:
             print(f"  {name}: {card['contacts']} contacts, generated in {card['generated']:.1f} s, "
                   f"analysed in {card['time']:.1f} s", file=sys.stderr, flush=True)
     total = time.perf_counter() - t0
-    machine = platform.processor() or platform.machine()
-    head = (f"Sorting-line scorecard ({'quick' if args.quick else 'full'}), {machine}, "
-            f"Python {platform.python_version()}, total {total:.0f} s")
+    head = f"Sorting-line scorecard ({'quick' if args.quick else 'full'}), {machine()}, total {total:.0f} s"
     print(head)
     print()
     print(table(cards))

@@ -408,9 +408,11 @@ def test_a_drop_keeps_the_fruit_damping_and_e_follows_the_law():
 # ---------------------------------------------------------------- issue 14 item 4: a lot varies by default
 def test_a_population_draws_the_fruit_library_spreads_unless_fixed(cli, tmp_path):
     """Before: `population --fruit apple` was N identical apples.  Now mass, modulus, failure stress and
-    susceptibility are drawn from the library ranges (normal about the value, sd = range/4, truncated to the
-    range) and the diameter follows the mass at the library density: every member satisfies
-    m = ρ π d³/6 exactly (float rounding), and each drawn input stays in its library range."""
+    susceptibility are drawn from the library ranges (a split normal with its median at the library value, each
+    side's sd half the distance from the value to that end of the range, truncated to it) and the diameter follows the mass at the
+    library density: every member satisfies m = ρ π d³/6 exactly (float rounding), and each drawn input stays in
+    its library range.  The spread bound is loose on purpose: a tenth of the symmetric sd (range/4), so it fails
+    only when an input is not drawn at all (sd 0), whatever the skew of the split normal."""
     apple = fruits()["apple"]
     out = tmp_path / "members.csv"
     cli.ok("population", "-n", "2000", "--fruit", "apple", "--drop-height", "4cm", "--criterion", "shear",

@@ -16,11 +16,11 @@ Crossley 1975: e = 1 − α V to first order; the founding paper's eq 6).
 
 How repeated impacts on the same spot accumulate damage (the rule, stated in
 every output and in docs/damage.md): the fruit lands on the same spot every
-time.  Under Thornton's law a re-impact at V ≤ e V reloads the flattened spot
-elastically along the unloading curve, Hertz with the enlarged radius R_p
-(TN98 eq 20), up to at most the largest force already reached: so the later
-bounces add viscous work but no plastic work, and their pressure is lower
-than the first impact's.  Each impact that meets the bruise criterion adds
+time.  A re-impact reloads the flattened spot as Hertz with its enlarged
+radius R_p (TN98 eq 20) up to the same yield pressure p_y, and yields again
+beyond it (issue 14 item 8): a later bounce can add plastic work, never a
+pressure above p_y.  A crushable board (cardboard) is taken fresh at each
+bounce: the model keeps no crushed spot on the surface.  Each impact that meets the bruise criterion adds
 BS (W_f − W_th)₊ to the bruise volume.  Measured apple bruises keep growing over
 3–5 repeated equal impacts before they stabilise (Komarnicki & Stopa 2013;
 the pendulum studies of docs/damage.md): this rule does not reproduce that
