@@ -23,11 +23,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import platform
 import time
 
 import numpy as np
 
+from bench_common import machine
 from fruitimpact.engine.powerlaw import (
     exact_x,
     powerlaw_characteristics,
@@ -91,8 +91,7 @@ def main(argv=None) -> None:
     parser.add_argument("--quick", action="store_true", help="2 M samples instead of 20 M")
     args = parser.parse_args(argv)
     samples = 2_000_000 if args.quick else 20_000_000
-    print(f"# fruitimpact signal benchmarks — {platform.processor() or platform.machine()}, "
-          f"Python {platform.python_version()}, NumPy {np.__version__}")
+    print(f"# fruitimpact signal benchmarks — {machine()}")
     print(f"# {samples:,} samples at {RATE:g} Hz per lane ({samples / RATE:g} s), one core\n")
     x, count = signal_with_impacts(samples)
     # warm up the JIT (compiled on first use, then cached on disk)
