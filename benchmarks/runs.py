@@ -1,12 +1,14 @@
 """End-to-end speed of batch and population runs, each against its baseline in the same run.
 
-    python benchmarks/runs.py [--rows 1000000] [--population 2000000]
+    python benchmarks/runs.py [--rows 1000000] [--population 2000000] [--evaluate 2000000]
 
 * ``batch``: ``fruitimpact batch IN.csv -o OUT.parquet`` on a CSV of ``--rows`` rows,
   against the I/O floor: ``pyarrow.csv.read_csv`` of IN plus
   ``pyarrow.parquet.write_table`` of a table with the output's size and schema.
   Measured as a subprocess (start-up included) and in-process; the in-process run
   is also given without ``fi.evaluate`` (its time measured on the same rows).
+* ``evaluate``: ``fi.evaluate`` of ``--evaluate`` rows against the plain NumPy floor of ``run.numpy_floor``
+  (k_c, e and δ_max of the same rows, nothing checked).
 * ``population``: ``population -n N`` (summary only, in-process, start-up
   excluded) against ``fi.evaluate`` of the same drawn members.
 
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -71,9 +74,14 @@ def batch(rows: int, repeats: int, folder: Path) -> list[tuple]:
         [exe, "-m", "fruitimpact.cli", "batch", str(source), "-o", str(out)]
     io_floor = best_of(floor, repeats)
     sub = best_of(lambda: subprocess.run(command, check=True, capture_output=True), repeats)
+    # the largest child so far is the batch command (the CSV was written in this process)
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024 ** 2  # KiB → GiB
+    size = source.stat().st_size / 1024 ** 3
     inproc = best_of(lambda: main(["batch", str(source), "-o", str(out)]), repeats)
     inputs = [t for _, (t, _) in runs.TableSource.open(source).payloads(runs.CHUNK_ROWS)]
     evaluation = best_of(lambda: [evaluate(t, tabulated=True) for t in inputs], repeats)
+    print(f"batch {rows:,} rows: peak memory of the command {peak:.2f} GiB for a {size:.2f} GiB CSV",
+          file=sys.stderr, flush=True)
     return [(f"batch {rows:,} rows CSV → Parquet, subprocess", sub, "I/O floor", io_floor),
             (f"batch {rows:,} rows CSV → Parquet, in-process", inproc, "I/O floor", io_floor),
             (f"batch {rows:,} rows, in-process without evaluate", inproc - evaluation, "I/O floor", io_floor),
@@ -107,11 +115,25 @@ def population(rows: int, repeats: int, folder: Path) -> list[tuple]:
     return [(f"population -n {rows:,}, summary only, in-process", run, "fi.evaluate, same members", evaluation)]
 
 
+def evaluate_floor(rows: int, repeats: int) -> list[tuple]:
+    from run import fruit_columns, numpy_floor  # the same floor as the engine table
+
+    from fruitimpact.impact.evaluation import evaluate
+
+    columns = fruit_columns(rows)
+    evaluate({k: a[:50_000] for k, a in columns.items()}, tabulated=True)  # compiled, tables built
+    floor = best_of(lambda: numpy_floor(columns), repeats)
+    ours = best_of(lambda: evaluate(columns, tabulated=True), repeats)
+    return [(f"fi.evaluate, {rows:,} rows (all characteristics, status)", ours, "NumPy: k_c, e, δ_max only", floor)]
+
+
 def main(argv=None) -> list:
     """Run the benchmarks, print them, and return (task, seconds, baseline, baseline seconds) lines."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rows", type=int, default=1_000_000, help="rows of the batch CSV (default 1e6)")
     parser.add_argument("--population", type=int, default=2_000_000, help="members (default 2e6)")
+    parser.add_argument("--evaluate", type=int, default=0, help="rows of fi.evaluate against NumPy (default: "
+                                                                  "none)")
     parser.add_argument("--repeats", type=int, default=3, help="best of this many runs (default 3)")
     args = parser.parse_args(argv)
     import contextlib
@@ -119,6 +141,7 @@ def main(argv=None) -> list:
 
     with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(io.StringIO()):
         lines = batch(args.rows, args.repeats, Path(tmp)) + population(args.population, args.repeats, Path(tmp))
+        lines += evaluate_floor(args.evaluate, args.repeats) if args.evaluate else []
     for task, value, baseline, base in lines:
         print(f"{task:<58} {value:8.2f} s | {baseline:<30} {base:8.2f} s  ratio {value / base:5.2f}×", flush=True)
     return lines

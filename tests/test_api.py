@@ -15,7 +15,7 @@ import fruitimpact as fi
 
 #: The task functions and what a reader needs in their docstrings (numpy style).
 TASKS = ("simulate", "evaluate", "drop", "safe_height", "risk_map", "audit_line", "analyze", "read_recording",
-         "fit_impact", "calibrate_classes")
+         "fit_impact", "calibrate_classes", "batch", "sweep", "population")
 SECTIONS = ("Parameters", "Returns", "Raises", "Examples", "References")
 
 
@@ -156,6 +156,105 @@ def test_evaluate_agrees_with_batch(cli, tmp_path):
     ok = library["status"] == "ok"
     assert written.loc[ok.to_numpy(), "peak_force"].tolist() == pytest.approx(
         library.loc[ok, "peak_force"].tolist(), rel=1e-12)
+
+
+def test_batch_agrees_with_the_cli(cli, tmp_path):
+    table = tmp_path / "in.csv"
+    table.write_text("fruit,drop_height,surface\napple,2cm,steel\npear,10cm,wood\napple,-1,steel\n")
+    import pandas as pd
+
+    cli.run("batch", table, "-o", tmp_path / "cli.csv")
+    summary = fi.batch(table, tmp_path / "api.csv")
+    assert (summary.ok, summary.invalid, summary.rows) == (2, 1, 3)
+    assert pd.read_csv(tmp_path / "api.csv").equals(pd.read_csv(tmp_path / "cli.csv"))
+
+
+def test_sweep_agrees_with_the_cli(cli, tmp_path):
+    import pandas as pd
+
+    cli.run("sweep", "--velocity", "0.5:1.5:3", "--model", "chen,flores", "--fruit", "pear", "-o", tmp_path / "g.csv")
+    written = pd.read_csv(tmp_path / "g.csv")
+    grid = fi.sweep(velocity="0.5:1.5:3", model=["chen", "flores"], fruit="pear")
+    assert written["velocity"].tolist() == grid["velocity"].tolist() == [0.5, 0.5, 1.0, 1.0, 1.5, 1.5]
+    assert written["model"].tolist() == grid["model"].astype(str).tolist()
+    assert written["peak_force"].tolist() == pytest.approx(grid["peak_force"].tolist(), rel=1e-12)
+    # to a file, the function is the command: the same rows
+    summary = fi.sweep(tmp_path / "api.csv", velocity="0.5:1.5:3", model="chen,flores", fruit="pear")
+    assert summary.rows == 6 and pd.read_csv(tmp_path / "api.csv").equals(written)
+
+
+def test_population_agrees_with_the_cli(cli, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # the run's work folder is made (and removed) here
+    report = cli.json("population", "-n", "3000", "--seed", "7", "--fruit", "apple", "--drop-height",
+                      "uniform(5cm,30cm)", "--criterion", "shear", "--threshold", "peak_force>60N")
+    summary = fi.population(3000, seed=7, fruit="apple", drop_height="uniform(5cm,30cm)", criterion="shear",
+                            thresholds=["peak_force>60N"])
+    library = json.loads(json.dumps(summary.to_dict()))
+    assert library.keys() == report.keys()
+    assert library["thresholds"] == report["thresholds"]
+    assert library["inputs"] == report["inputs"] and library["spreads"] == report["spreads"]
+    assert library["statistics"]["peak_force"]["mean"] == pytest.approx(
+        report["statistics"]["peak_force"]["mean"], rel=1e-12)
+
+
+@pytest.mark.parametrize("argv,call", [
+    (["population", "-n", "0"], lambda: fi.population("0")),
+    (["population", "--seed", "-3"], lambda: fi.population(seed="-3")),
+    (["population", "--mass", "normal(1,"], lambda: fi.population(mass="normal(1,")),
+    (["population", "--velocity", "1", "--drop-height", "1"], lambda: fi.population(velocity=1, drop_height=1)),
+    (["population", "--threshold", "peak>1"], lambda: fi.population(thresholds=["peak>1"])),
+    (["population", "--percentiles", "5,200"], lambda: fi.population(percentiles="5,200")),
+    (["sweep", "--velocity", "1:2", "-o", "x.csv"], lambda: fi.sweep(velocity="1:2")),
+    (["sweep", "--velocity", "1:2:3", "--fruit", "kiwi", "-o", "x.csv"], lambda: fi.sweep(velocity="1:2:3", fruit="kiwi")),
+    (["sweep", "--velocity", "1:2:3", "--mass", "-1", "-o", "x.csv"], lambda: fi.sweep(velocity="1:2:3", mass=-1)),
+    (["sweep", "--velocity", "1:2:3", "-o", "x.gif"], lambda: fi.sweep("x.gif", velocity="1:2:3")),
+    (["batch", "missing.csv", "-o", "x.csv"], lambda: fi.batch("missing.csv", "x.csv")),
+    (["batch", "in.csv", "-o", "x.csv", "--chunk-size", "0"], lambda: fi.batch("in.csv", "x.csv", chunk_size="0")),
+])
+def test_the_run_functions_refuse_what_the_commands_refuse(cli, tmp_path, monkeypatch, argv, call):
+    """One path: the function's ValueError is the command's line, with the option in place of the argument."""
+    from fruitimpact.cli.common import usage_message
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "in.csv").write_text("mass\n0.1\n")
+    line = cli.error(*argv)
+    with pytest.raises(ValueError) as caught:
+        call()
+    assert line.endswith(usage_message(caught.value)), (line, str(caught.value))
+    assert not list(tmp_path.glob(".fruitimpact-*")), "a refused run left a work folder"
+
+
+#: ``fruitimpact synth``'s defaults as library arguments (its --seed S seeds the fruit with S + 1).
+SYNTH_LOT = dict(interval=0.25, mass="115g", diameter="65mm", modulus="3MPa", poisson=0.37, drop_height="5cm",
+                 restitution=0.577, modulus_spread=0.15, rebounds=1,
+                 classes={"soft": 2.5e6, "medium": 3.5e6, "firm": math.inf})
+
+
+def test_synthesize_agrees_with_synth(cli, tmp_path):
+    """The same arguments give the same samples and the same truth."""
+    cli.run("synth", "-o", tmp_path / "cli.npy", "--seed", "3", "--count", "4")
+    recording, truth = fi.synthesize(fi.SensorModel(seed=3, noise=0.01), fi.Population(count=4, seed=4, **SYNTH_LOT))
+    written = fi.read_recording(tmp_path / "cli.npy", rate=recording.rate)
+    assert np.array_equal(written.lanes["lane0"], recording.lanes["lane0"])
+    cli_truth = json.loads((tmp_path / "cli.truth.json").read_text())
+    assert [i["peak_force"] for i in cli_truth["impacts"]] == [i["peak_force"] for i in truth["impacts"]]
+
+
+def test_stream_analyzer_agrees_with_stream(script, tmp_path):
+    """The push-style analyzer and ``fruitimpact stream`` (text samples on stdin) report the same impacts."""
+    recording, _ = fi.synthesize(fi.SensorModel(seed=5, rate=20_000.0, noise=0.01),
+                                 fi.Population(count=3, seed=6, **SYNTH_LOT))
+    samples = np.asarray(recording.lanes["lane0"])
+    text = "".join(f"{float(v)!r}\n" for v in samples)
+    done = script("stream", "--rate", "20000", input=text)
+    assert done.returncode == 0, done.stderr
+    lines = [json.loads(line) for line in done.stdout.splitlines()]
+    analyzer = fi.StreamAnalyzer(20_000.0)
+    for start in range(0, samples.size, 4096):  # pushed in blocks, as a live source delivers them
+        analyzer.feed(samples[start:start + 4096])
+    analyzer.close()
+    assert len(lines) == len(analyzer.results) >= 3
+    assert [r["peak_force"] for r in lines] == pytest.approx([r["peak_force"] for r in analyzer.results], rel=1e-9)
 
 
 def test_paper_report_agrees_with_the_cli(cli):

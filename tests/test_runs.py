@@ -327,10 +327,10 @@ def test_work_directory_of_another_job_is_refused(tmp_path, cli, monkeypatch):
     (["--threshold", "peak_force=1"], "argument --threshold: a threshold is NAME>VALUE"),
     (["--characteristics", "peak_force,nope"], "argument --characteristics: unknown characteristic 'nope'"),
     (["--percentiles", "50,101"], "argument --percentiles"),
-    (["-n", "0"], "argument -n/--rows: must be an integer in [1, 1,000,000,000]"),
-    (["--seed", "-3"], "argument --seed: must be an integer >= 0"),
+    (["-n", "0"], "argument -n/--rows: rows must be an integer in [1, 1,000,000,000]"),
+    (["--seed", "-3"], "argument --seed: seed must be an integer >= 0"),
     (["--model", "nope"], "argument --model: model must be one of"),
-    (["--chunk-size", "1.5"], "argument --chunk-size: must be an integer in [1, 10,000,000]"),
+    (["--chunk-size", "1.5"], "argument --chunk-size: chunk_size must be an integer in [1, 10,000,000]"),
 ])
 def test_population_bad_input_one_line(cli, argv, message):
     line = cli.error("population", *argv)

@@ -196,11 +196,11 @@ def test_stale_temporaries_of_the_output_are_removed(tmp_path, cli):
     (["sweep", "--velocity", "1:2:3", "--plot", "p.gif"], "argument --plot: cannot write 'p.gif': unsupported format"),
     (["population", "-n", 100, "--scheduler", "not an address"], "argument --scheduler: a scheduler address is like"),
     (["population", "-n", 100, "--workdir", "afile/wd"], "argument --workdir"),
-    (["population", "-n", "1e20"], "argument -n/--rows: must be an integer in [1, 1,000,000,000]; got '1e20'"),
+    (["population", "-n", "1e20"], "argument -n/--rows: rows must be an integer in [1, 1,000,000,000]; got '1e20'"),
     (["sweep", "--velocity", "0.3:1.5:100000000000", "-o", "x.csv"], "argument --velocity: the COUNT"),
     (["sweep", "--velocity", "0.3:1.5:1000000", "--mass", "0.1:0.2:1001", "-o", "x.csv"], "the grid has 1,001,000,000"),
-    (["population", "--sample-size", "1e9"], "argument --sample-size: must be an integer in [1, 20,000,000]"),
-    (["population", "--workers", "0", "--engine", "dask"], "argument --workers: must be an integer in [1, 256]"),
+    (["population", "--sample-size", "1e9"], "argument --sample-size: sample_size must be an integer in [1, 20,000,000]"),
+    (["population", "--workers", "0", "--engine", "dask"], "argument --workers: workers must be an integer in [1, 256]"),
 ])
 def test_bad_outputs_and_limits_are_one_line_before_work(tmp_path, cli, monkeypatch, argv, words):
     monkeypatch.chdir(tmp_path)

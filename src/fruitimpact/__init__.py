@@ -35,6 +35,8 @@ _EXPORTS = {
     "FirmnessClasses": "signals.sort",
     "synthesize": "signals.synth", "SensorModel": "signals.synth", "Population": "signals.synth",
     "write_recording": "signals.synth",                         # fruitimpact synth
+    "batch": "runs.tasks", "sweep": "runs.tasks", "population": "runs.tasks",  # fruitimpact batch/sweep/population
+    "RunSummary": "runs.summaries",
     "fruits": "library", "surfaces": "library",                 # fruitimpact fruits / surfaces
     "paper_report": "reference.paper",                          # fruitimpact paper
     "restitution_table": "reference.comparison",                # fruitimpact models

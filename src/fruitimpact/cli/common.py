@@ -58,18 +58,25 @@ def _quantities(args, options=IMPACT_OPTIONS) -> dict:
 
 
 def usage_message(exc: ValueError) -> str:
-    """A library error as the CLI's line: the option named from the error's argument."""
+    """A library error as the CLI's line: the option named from the error's argument (a message that starts
+    with the argument's own name and a colon, ``workdir: ...``, names it once)."""
     argument = getattr(exc, "argument", None)
     if isinstance(argument, tuple):  # a conflict between inputs given together
         return conflict_message([option_of(name) for name in argument])
     if isinstance(argument, str) and (argument in INPUTS or argument in COMMAND_ARGUMENTS):
-        return f"argument {option_of(argument)}: {exc}"
+        text = str(exc)
+        text = text[len(argument) + 2:] if text.startswith(argument + ": ") else text
+        return f"argument {COMMAND_ARGUMENTS.get(argument) or option_of(argument)}: {text}"
     return str(exc)
 
 
-#: Library arguments of the commands that are not table inputs but are CLI options of the same name
-#: (``drop``'s ``bounces`` and ``max_impacts``, ``line``'s ``alternatives``).
-COMMAND_ARGUMENTS = ("bounces", "max_impacts", "alternatives")
+#: Library arguments of the commands that are not table inputs, and their CLI options (``drop``'s
+#: ``bounces``, ``line``'s ``alternatives``, the run options of ``batch``, ``sweep`` and ``population``).
+COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "alternatives": "--alternatives",
+                     "rows": "-n/--rows", "seed": "--seed", "chunk_size": "--chunk-size", "workers": "--workers",
+                     "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
+                     "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
+                     "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size"}
 
 
 def _library_call(func, *args, **kwargs):
@@ -78,17 +85,6 @@ def _library_call(func, *args, **kwargs):
         return func(*args, **kwargs)
     except ValueError as exc:
         raise UsageError(usage_message(exc)) from None
-
-
-def _with_option(message: str) -> str:
-    """Prefix a batch row's message with the CLI option it concerns ("mass ..." → "argument --mass: mass ...")."""
-    if message.startswith("give either"):  # a conflict: name both options as typed
-        words = message.split()
-        return f"give either --{words[2].replace('_', '-')} or --{words[4].rstrip(',').replace('_', '-')}, not both"
-    name = message.split(" ", 1)[0]
-    if name in INPUTS:
-        return f"argument {option_of(name)}: {message}"
-    return message
 
 
 def _add_impact_options(parser: argparse.ArgumentParser) -> None:
@@ -183,22 +179,6 @@ class _Ordered(argparse.Action):
         namespace.order = [d for d in (getattr(namespace, "order", None) or []) if d != self.dest] + [self.dest]
 
 
-def _positive_count(option: str, text: str, minimum: int = 1) -> int:
-    """"1e7" or "10000000" → int >= minimum."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value == int(value) and value >= minimum):
-        raise UsageError(f"argument {option}: must be an integer >= {minimum}; got {text!r}")
-    return int(value)
-
-
-
-_SI_OF = {name: quantity.si_unit for name, quantity in INPUTS.items() if quantity.numeric}
-
-
-
 _NEGATIVE = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
 
 
@@ -278,13 +258,6 @@ def add_spread_option(parser) -> None:
     parser.add_argument("--no-spreads", action="store_true",
                         help="identical fruit: do not draw mass, size, modulus, failure stress and susceptibility "
                              "from the fruit's library spreads (by default a lot varies; giving an option fixes it)")
-
-
-def lot_distributions(args, fruit: str | None, given: list[str], criterion: str | None):
-    """``impact.presets.lot_distributions`` with ``--no-spreads``; its error names ``--fruit``."""
-    from fruitimpact.impact.presets import lot_distributions as library_lot
-
-    return _library_call(library_lot, fruit, given, criterion, spreads=not args.no_spreads)
 
 
 def print_spreads(command: str, lines) -> None:

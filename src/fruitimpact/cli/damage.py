@@ -139,19 +139,16 @@ def cmd_safe_height(args) -> int:
 
 # ------------------------------------------------------------------------------------------------ line
 def cmd_line(args) -> int:
-    from fruitimpact.cli.runs import _count
-    from fruitimpact.handling.line import MAX_LINE_FRUIT, audit_line, read_line
+    from fruitimpact.handling.line import audit_line, read_line
 
     try:
         points = read_line(args.line)
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
     _check_outputs([("--plot", args.plot, "figure")])
-    rows = _count("-n/--rows", args.rows, 1, MAX_LINE_FRUIT)
-    seed = _count("--seed", args.seed, 0)
     given = {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
              if getattr(args, quantity.name, None) is not None}
-    report = _library_call(audit_line, points, rows=rows, seed=seed, spreads=not args.no_spreads,
+    report = _library_call(audit_line, points, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
                            alternatives=args.alternatives, **given)
     criterion = report["criterion"]
     spread_lines = report["spreads"]
@@ -166,7 +163,7 @@ def cmd_line(args) -> int:
     if args.json:
         print(dump_json(report))
     else:
-        print(f"line {args.line}: {rows} fruit, criterion {criterion}; bruised on the line "
+        print(f"line {args.line}: {report['rows']} fruit, criterion {criterion}; bruised on the line "
               f"{report['incidence'] * 100:.3g} %, mean bruise volume {report['mean_bruise_volume'] * 1e9:.4g} mm³")
         print(f"{'transfer point':<22}{'h [cm]':>8}{'surface':>13}{'incidence':>11}{'BV [mm³]':>10}"
               f"{'cum. inc.':>11}{'cum. BV':>10}{'F_max [N]':>11}")

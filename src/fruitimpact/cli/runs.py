@@ -8,41 +8,11 @@ its allowed range, exit status 2.
 from __future__ import annotations
 
 import argparse
-import decimal
 import importlib.util
-import math
 import sys
-from pathlib import Path
 
-from fruitimpact.cli.common import PROG, UsageError, _with_option, add_spread_option, dump_json, lot_distributions, print_spreads
-
-#: Inputs whose range depends on other inputs: not checked alone when constant.
-_DEPENDENT_INPUTS = ("alpha", "step")
-#: Most worker processes of a local Dask cluster.
-MAX_WORKERS = 256
-
-
-class _Ordered(argparse.Action):
-    """Store the value and remember the order in which the options were given (sweep axes)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        setattr(namespace, self.dest, values)
-        namespace.order = [d for d in (getattr(namespace, "order", None) or []) if d != self.dest] + [self.dest]
-
-
-def _count(option: str, text: str, low: int, high: int | None = None) -> int:
-    """An exact integer in [low, high] from ``"10000000"`` or ``"1e7"`` (never through a float,
-    so that a seed above 2^53 keeps every digit)."""
-    allowed = f"an integer >= {low:,}" if high is None else f"an integer in [{low:,}, {high:,}]"
-    try:
-        value = decimal.Decimal(str(text).strip())
-    except decimal.InvalidOperation:
-        value = None
-    if value is None or not value.is_finite() or value != value.to_integral_value() \
-            or value < low or (high is not None and value > high):
-        raise UsageError(f"argument {option}: must be {allowed}; got {text!r}")
-    return int(value)
-
+from fruitimpact.cli.common import (PROG, UsageError, _library_call, _Ordered, add_spread_option, dump_json,
+                                    print_spreads, usage_message)
 
 def _run_inputs():
     """(option, name, quantity) of every input of the table of quantities, numeric first."""
@@ -53,6 +23,7 @@ def _run_inputs():
 
 def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> None:
     from fruitimpact.runs import CHUNK_ROWS, ENGINES, MAX_CHUNK_ROWS
+    from fruitimpact.runs.tasks import MAX_WORKERS
 
     group = parser.add_argument_group("run (chunks, resume, engines)")
     group.add_argument("-o", "--output", metavar="OUT", required=output_required,
@@ -96,46 +67,24 @@ def _check_figure(option: str, path) -> None:
         raise UsageError(f"argument {option}: figures need matplotlib: pip install 'fruitimpact[plot]'")
 
 
-def _check_run_options(args, plan):
-    """The output, the work folder and the engine of ``args``, checked before any work; returns
-    (engine, work folder)."""
-    from fruitimpact import runs
-    from fruitimpact.impact.outputs import TABLE_FORMATS, check_folder
-
-    if args.output is not None:
-        _check_output("-o/--output", args.output, TABLE_FORMATS)
-    workers = _count("--workers", args.workers, 1, MAX_WORKERS)
-    if args.scheduler is not None:
-        try:
-            runs.engines.check_scheduler(args.scheduler)
-        except ValueError as exc:
-            raise UsageError(f"argument --scheduler: {exc}") from None
-    dask = (args.engine or ("dask" if args.scheduler else "inprocess")) == "dask"
-    if dask and importlib.util.find_spec("distributed") is None:
-        raise UsageError("argument --engine: dask needs dask[distributed]: pip install 'fruitimpact[dask]'")
-    engine = runs.DaskEngine(scheduler=args.scheduler, workers=workers) if dask else runs.InProcessEngine()
-    workdir = Path(args.workdir) if args.workdir else runs.default_workdir(args.output, plan)
-    existing = workdir
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
-    try:
-        if existing.exists() and not existing.is_dir():
-            raise ValueError(f"argument --workdir: cannot use {str(workdir)!r}: {str(existing)!r} is not a folder")
-        check_folder(existing, "--workdir", workdir)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    return engine, workdir
+def _run_options(args) -> dict:
+    return dict(engine=args.engine, scheduler=args.scheduler, workers=args.workers, workdir=args.workdir)
 
 
 def _run(args, plan, keep_columns=(), percentiles=None):
-    """Execute ``plan`` with the run options of ``args``; one-line errors, resumable interruption."""
+    """``runs.tasks.run`` of ``plan`` with the run options of ``args``: the output, the work folder and the
+    engine checked before any work; one-line errors; an interruption keeps the completed chunks."""
     from fruitimpact import runs
+    from fruitimpact.runs import tasks
 
-    engine, workdir = _check_run_options(args, plan)
+    options = _run_options(args)
+    _, workdir = _library_call(tasks.check_run, plan, args.output, **options)
     try:
-        return runs.execute(plan, args.output, engine=engine, workdir=workdir, fresh=args.fresh,
-                            keep_columns=keep_columns, percentiles=percentiles or runs.PERCENTILES)
-    except (runs.RunError, ValueError) as exc:
+        return tasks.run(plan, args.output, fresh=args.fresh, keep_columns=keep_columns,
+                         percentiles=percentiles or runs.PERCENTILES, **options)
+    except ValueError as exc:
+        raise UsageError(usage_message(exc)) from None
+    except runs.RunError as exc:
         raise UsageError(str(exc)) from None
     except KeyboardInterrupt:
         print(f"{PROG} {args.command}: interrupted; completed chunks are kept in {workdir}: "
@@ -153,56 +102,10 @@ def _status_line(summary) -> str:
     return line
 
 
-def _check_constants(constants: dict, text: dict, given=()) -> None:
-    """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
-    energy criterion's threshold), before any chunk runs (one row through impact.evaluation.evaluate)."""
-    from fruitimpact.impact.evaluation import evaluate
-    from fruitimpact.impact.quantities import INPUTS
-
-    if not constants and not text:
-        return
-    probe = evaluate({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
-    message = str(probe["message"].iloc[0])
-    first = message.split(" ", 1)[0]
-    if str(probe["status"].iloc[0]) != "invalid" or first in _DEPENDENT_INPUTS:
-        return
-    # a refusal naming an input nobody gave is one the constants cause (a threshold the energy criterion needs,
-    # a failure stress the fruit lacks): it would refuse every member
-    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
-        raise UsageError(_with_option(message))
-
-
-def _check_text(name: str, values) -> None:
-    from fruitimpact.impact.quantities import option_of
-    from fruitimpact.impact.registries import REGISTRIES
-
-    registry = REGISTRIES[name]
-    for value in values:
-        if value not in registry:
-            raise UsageError(f"argument {option_of(name)}: {name} must be one of {', '.join(registry)}; "
-                             f"got {value!r}")
-
-
-def _check_conflicts(given) -> None:
-    from fruitimpact.impact.quantities import ALTERNATIVES
-
-    for group in ALTERNATIVES:
-        named = [name for name in group if name in given]
-        if len(named) > 1:
-            options = " or ".join("--" + name.replace("_", "-") for name in named)
-            raise UsageError(f"give either {options}, not both")
-
-
 def cmd_batch(args) -> int:
-    from fruitimpact.runs import MAX_CHUNK_ROWS, Plan, TableSource
+    from fruitimpact.runs import tasks
 
-    try:
-        source = TableSource.open(args.input)
-    except ValueError as exc:
-        raise UsageError(f"argument IN: {exc}") from None
-    if args.output and source.path == str(Path(args.output).resolve()):
-        raise UsageError("argument -o/--output: must differ from the input file")
-    plan = Plan("batch", source, _count("--chunk-size", args.chunk_size, 1, MAX_CHUNK_ROWS))
+    plan = _library_call(tasks.batch_plan, args.input, args.output, args.chunk_size)
     summary = _run(args, plan)
     if summary is None:
         return 130
@@ -212,25 +115,10 @@ def cmd_batch(args) -> int:
 
 def cmd_sweep(args) -> int:
     from fruitimpact import runs
+    from fruitimpact.runs import tasks
 
-    axes, constants, text = [], {}, {}
     order = list(getattr(args, "order", None) or [])
-    for dest in order:
-        option = "--" + dest.replace("_", "-")
-        try:
-            axis = runs.parse_axis(dest, getattr(args, dest))
-        except ValueError as exc:
-            raise UsageError(f"argument {option}: {exc}") from None
-        if not axis.numeric:
-            _check_text(dest, axis.values)
-        if len(axis.values) > 1:
-            axes.append(axis)
-        elif axis.numeric:
-            constants[dest] = axis.values[0]
-        else:
-            text[dest] = axis.values[0]
-    _check_conflicts(order)
-    _check_constants(constants, text, order)
+    plan, axes = _library_call(tasks.sweep_plan, {dest: getattr(args, dest) for dest in order}, args.chunk_size)
     try:
         name = runs.characteristic(args.characteristic).name
     except ValueError as exc:
@@ -241,20 +129,13 @@ def cmd_sweep(args) -> int:
     if not (args.output or args.plot):
         raise UsageError("argument -o/--output: give -o OUT and/or --plot FILE")
     _check_figure("--plot", args.plot)
-    points = math.prod(len(a.values) for a in axes)
-    if points > runs.MAX_ROWS:
-        raise UsageError(f"the grid has {points:,} points ({' × '.join(str(len(a.values)) for a in axes)}); "
-                         f"a sweep has at most {runs.MAX_ROWS:,}")
-    fixed = [runs.Axis(k, (v,)) for k, v in {**constants, **text}.items()]
-    grid = runs.GridSource(tuple(axes + fixed))
-    plan = runs.Plan("sweep", grid, _count("--chunk-size", args.chunk_size, 1, runs.MAX_CHUNK_ROWS))
     summary = _run(args, plan, keep_columns=(name,) if args.plot else ())
     if summary is None:
         return 130
     shape = " × ".join(f"{len(a.values)} {a.name}" for a in axes) or "1 point"
     print(f"sweep: {shape}; {_status_line(summary)}" + (f"; written to {summary.output}" if summary.output else ""))
     if args.plot:
-        _save("--plot", runs.sweep_figure(grid, summary.columns[name], name), args.plot)
+        _save("--plot", runs.sweep_figure(plan.source, summary.columns[name], name), args.plot)
         print(f"figure written to {args.plot}")
     return 0
 
@@ -291,62 +172,25 @@ def _format_population(summary, names) -> str:
 
 def cmd_population(args) -> int:
     from fruitimpact import runs
-    from fruitimpact.impact.distributions import Constant, parse_distribution
+    from fruitimpact.runs import tasks
 
-    rows = _count("-n/--rows", args.rows, 1, runs.MAX_ROWS)
-    seed = _count("--seed", args.seed, 0)
-    distributions, constants, text = [], {}, {}
-    for option, dest, quantity in _run_inputs():
-        spec = getattr(args, dest)
-        if spec is None:
-            continue
-        if not quantity.numeric:
-            _check_text(dest, [spec])
-            text[dest] = spec
-            continue
-        try:
-            dist = parse_distribution(spec, quantity.dimension, dest)
-        except ValueError as exc:
-            raise UsageError(f"argument {option}: {exc}") from None
-        distributions.append((dest, dist))
-        if isinstance(dist, Constant):
-            constants[dest] = dist.value
-    _check_conflicts([d for d, _ in distributions])
-    _check_constants(constants, text, [d for d, _ in distributions] + list(text))
-    spreads, density, spread_lines = lot_distributions(args, text.get("fruit"), [d for d, _ in distributions],
-                                                       text.get("criterion"))
-    distributions += list(spreads)
-    try:
-        names = runs.characteristics_list(args.characteristics) if args.characteristics else runs.DEFAULT_SUMMARY
-    except ValueError as exc:
-        raise UsageError(f"argument --characteristics: {exc}") from None
-    thresholds = []
-    for item in args.threshold or ():
-        try:
-            thresholds.append(runs.Threshold.parse(item))
-        except ValueError as exc:
-            raise UsageError(f"argument --threshold: {exc}") from None
-    try:
-        percentiles = tuple(float(p) for p in args.percentiles.split(","))
-    except ValueError:
-        percentiles = (math.nan,)
-    if not all(0 <= p <= 100 for p in percentiles):
-        raise UsageError(f"argument --percentiles: each must be a number in [0, 100]; got {args.percentiles!r}")
+    inputs = {dest: getattr(args, dest) for _, dest, _ in _run_inputs() if getattr(args, dest) is not None}
+    plan, distributions, spread_lines = _library_call(
+        tasks.population_plan, inputs, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
+        characteristics=args.characteristics, thresholds=args.threshold or (), sample_size=args.sample_size,
+        chunk_size=args.chunk_size, write_rows=args.output is not None)
+    percentiles = _library_call(tasks.check_percentiles, args.percentiles)
     _check_figure("--hist", args.hist)
-    source = runs.PopulationSource(tuple(distributions), tuple(text.items()), rows, seed, density)
-    plan = runs.Plan("population", source, _count("--chunk-size", args.chunk_size, 1, runs.MAX_CHUNK_ROWS),
-                     write_rows=args.output is not None, stats=names, thresholds=tuple(thresholds),
-                     sample_rows=_count("--sample-size", args.sample_size, 1, runs.MAX_SAMPLE_ROWS))
     summary = _run(args, plan, percentiles=percentiles)
     if summary is None:
         return 130
+    summary.details = {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in distributions},
+                       "spreads": list(spread_lines)}
+    names = plan.stats
     if args.hist:
         _save("--hist", runs.histogram_figure(summary.sample, names, summary.percentiles["exact"]), args.hist)
     if args.json:
-        report = summary.to_dict()
-        report["seed"], report["inputs"] = seed, {name: dist.describe() for name, dist in distributions}
-        report["spreads"] = list(spread_lines)
-        print(dump_json(report))
+        print(dump_json(summary.to_dict()))
     else:
         print_spreads("population", spread_lines)
         print(_format_population(summary, names))

@@ -317,10 +317,10 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
     from fruitimpact.impact.presets import fruit_criterion, lot_distributions
     from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.registries import REGISTRIES
-    from fruitimpact.impact.validation import InputError, check_choice, check_integer
+    from fruitimpact.impact.validation import InputError, check_choice, read_count
 
-    rows = check_integer("rows", rows, 1, MAX_LINE_FRUIT)
-    seed = check_integer("seed", seed, 0)
+    rows = read_count("rows", rows, 1, MAX_LINE_FRUIT)
+    seed = read_count("seed", seed, 0)
     points = _points(line)
     if criterion == "none":
         raise InputError("criterion must be given for a line audit: pressure, shear or energy (the onset height "

@@ -132,6 +132,27 @@ def check_integer(name: str, value, low: int, high: int | None = None, *, owner:
     return int(value)
 
 
+def read_count(name: str, value, low: int, high: int | None = None) -> int:
+    """An exact integer in [low, high] from an int or a text such as ``"10000000"`` or ``"1e7"`` (read as a
+    decimal, never through a float, so that a seed above 2^53 keeps every digit); ``InputError`` naming
+    ``name`` otherwise (a bool, a fraction, NaN)."""
+    import decimal
+
+    allowed = f">= {low:,}" if high is None else f"in [{low:,}, {high:,}]"
+    number = None
+    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        number = decimal.Decimal(int(value))
+    elif isinstance(value, str):
+        try:
+            number = decimal.Decimal(value.strip())
+        except decimal.InvalidOperation:
+            number = None
+    if number is None or not number.is_finite() or number != number.to_integral_value() or number < low \
+            or (high is not None and number > high):
+        raise InputError(f"{name} must be an integer {allowed}; got {value!r}", name)
+    return int(number)
+
+
 def conflict_message(names) -> str:
     """``give either velocity or drop_height, not both`` (or one of three)."""
     names = list(names)
@@ -224,4 +245,5 @@ def implausible_message(quantity: Quantity, value: float | None = None) -> str:
 
 
 __all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_value", "conflict_message",
-           "implausible_message", "nan_message", "range_message", "read_value", "unreadable_message"]
+           "implausible_message", "nan_message", "range_message", "read_count", "read_value",
+           "unreadable_message"]

@@ -30,11 +30,14 @@ class RunSummary:
     sample: np.ndarray | None = None  # the percentile sample, one column per statistic
     columns: dict = field(default_factory=dict)  # columns read back for figures (keep_columns)
     statuses: dict = field(default_factory=dict)  # rows per status, every status evaluate reported
+    details: dict = field(default_factory=dict)  # what the run was asked (a population's seed, inputs, spreads)
 
     def to_dict(self) -> dict:
+        """The summary as JSON-ready values (``fruitimpact population --json``)."""
         return {"kind": self.kind, "rows": self.rows, "ok": self.ok, "invalid": self.invalid, "failed": self.failed,
                 "statuses": self.statuses, "output": self.output, "resumed_chunks": self.resumed_chunks,
-                "percentile_method": self.percentiles, "statistics": self.statistics, "thresholds": self.thresholds}
+                "percentile_method": self.percentiles, "statistics": self.statistics, "thresholds": self.thresholds,
+                **self.details}
 
 
 def add_statuses(records) -> dict[str, int]:

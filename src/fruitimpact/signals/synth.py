@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
+from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_integer, check_number
 from fruitimpact.signals.read import _column, recording_format
 from fruitimpact.signals.recording import Recording
@@ -56,8 +57,25 @@ _NODES = 129
 TAIL = 0.02
 
 
+#: The dimension of each setting that may be given as a string with units (``"115g"``, ``"20kHz"``), as the
+#: CLI reads them (``impact.units``).
+_DIMENSIONS = {"mass": "mass", "diameter": "length", "modulus": "modulus", "poisson": "dimensionless",
+               "velocity": "velocity", "drop_height": "length", "restitution": "dimensionless", "alpha": "alpha",
+               "time": "time", "interval": "time", "jitter": "time", "start": "time", "rate": "frequency",
+               "hum_frequency": "frequency", "plate_frequency": "frequency", "antialias_cutoff": "frequency",
+               "noise_sd": "force", "hum_amplitude": "force", "clip_low": "force", "clip_high": "force",
+               "noise": "dimensionless", "modulus_spread": "dimensionless", "mass_spread": "dimensionless",
+               "plate_damping": "dimensionless"}
+
+
 def _number(owner: str, name: str, value, **bounds):
-    """``validation.check_number`` with the settings object's name in the message."""
+    """``validation.check_number`` with the settings object's name in the message; a string is read with its
+    unit first (``_DIMENSIONS``)."""
+    if isinstance(value, str) and name in _DIMENSIONS:
+        try:
+            value = parse_quantity(value, _DIMENSIONS[name])
+        except ValueError as exc:
+            raise InputError(f"{owner}.{name}: {exc}", name) from None
     return check_number(name, value, owner=owner, **bounds)
 
 

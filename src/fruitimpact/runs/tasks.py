@@ -1,0 +1,445 @@
+"""The three runs of many impacts as Python functions: ``batch``, ``sweep`` and ``population``.
+
+Each is the CLI command of the same name (``fruitimpact batch``, ``sweep``, ``population``) and goes
+through the same checks, in the same order, before any work: the CLI calls the ``*_plan`` functions
+and ``run`` below and only adds its figures and its printing.  A refused argument is an
+``impact.validation.InputError`` (a ``ValueError``) naming the argument; a run that cannot start or
+continue (a work folder of another job, a lock held, a full disk) is a ``RunError``.  An interrupted run
+(Ctrl-C) keeps its completed chunks in the work folder: the same call resumes it.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+from fruitimpact.impact.validation import InputError, check_choice, conflict_message, read_count
+from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
+                                   Plan, Threshold, characteristic, characteristics_list)
+
+#: Inputs whose range depends on other inputs: not checked alone when constant.
+_DEPENDENT_INPUTS = ("alpha", "step")
+#: Most worker processes of a local Dask cluster.
+MAX_WORKERS = 256
+#: Most grid points ``sweep`` returns as a DataFrame (about 1 kB a row); larger grids go to a file.
+MAX_FRAME_ROWS = 2_000_000
+
+
+# --- the run: output, work folder, engine ------------------------------------------------------------------------
+
+def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=None):
+    """The output, the engine and the work folder of a run, checked before any work: (engine, work folder).
+
+    ``engine``: ``"inprocess"`` (default) or ``"dask"`` (implied by ``scheduler``, a Dask address such as
+    ``tcp://10.0.0.5:8786``); ``workers``: processes of a local Dask cluster, 1 to ``MAX_WORKERS``;
+    ``workdir``: the folder of the part files (default ``OUTPUT.parts``), new, empty or one fruitimpact made."""
+    from fruitimpact import runs
+    from fruitimpact.impact.outputs import TABLE_FORMATS, check_folder, check_output
+
+    if output is not None:
+        try:
+            check_output(output, "output", TABLE_FORMATS)
+        except OSError as exc:  # e.g. a name too long to even look up
+            raise InputError(f"output: cannot write {str(output)!r}: {exc.strerror}", "output") from None
+        except ValueError as exc:
+            raise InputError(str(exc), "output") from None
+    workers = read_count("workers", workers, 1, MAX_WORKERS)
+    if scheduler is not None:
+        try:
+            runs.engines.check_scheduler(scheduler)
+        except ValueError as exc:
+            raise InputError(f"scheduler: {exc}", "scheduler") from None
+    engine = check_choice("engine", engine or ("dask" if scheduler else "inprocess"), tuple(runs.ENGINES))
+    if engine == "dask" and importlib.util.find_spec("distributed") is None:
+        raise InputError("engine dask needs dask[distributed]: pip install 'fruitimpact[dask]'", "engine")
+    chosen = runs.DaskEngine(scheduler=scheduler, workers=workers) if engine == "dask" else runs.InProcessEngine()
+    folder = Path(workdir) if workdir else runs.default_workdir(output, plan)
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    try:
+        if existing.exists() and not existing.is_dir():
+            raise ValueError(f"workdir: cannot use {str(folder)!r}: {str(existing)!r} is not a folder")
+        check_folder(existing, "workdir", folder)
+    except ValueError as exc:
+        raise InputError(str(exc), "workdir") from None
+    return chosen, folder
+
+
+def run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=None, fresh: bool = False,
+        keep_columns=(), percentiles=PERCENTILES):
+    """Execute ``plan`` (``runs.execute``) after ``check_run``; returns the ``RunSummary``.  ``fresh`` discards
+    the parts of another job in the work folder (only a folder fruitimpact made and marked)."""
+    from fruitimpact.runs.driver import execute
+
+    chosen, folder = check_run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir)
+    return execute(plan, output, engine=chosen, workdir=folder, fresh=fresh, keep_columns=keep_columns,
+                   percentiles=percentiles)
+
+
+# --- the inputs of a grid or a population --------------------------------------------------------------------------
+
+def _input(name: str):
+    from fruitimpact.impact.quantities import INPUTS
+
+    quantity = INPUTS.get(name)
+    if quantity is None:
+        raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
+    return quantity
+
+
+def _check_text(name: str, values) -> None:
+    from fruitimpact.impact.registries import REGISTRIES
+
+    for value in values:
+        check_choice(name, value, REGISTRIES[name])
+
+
+def _check_conflicts(given) -> None:
+    """Refuse two inputs of one group of alternatives (velocity and drop_height, ...)."""
+    from fruitimpact.impact.quantities import ALTERNATIVES
+
+    for group in ALTERNATIVES:
+        named = [name for name in group if name in given]
+        if len(named) > 1:
+            raise InputError(conflict_message(named), tuple(named))
+
+
+def _check_constants(constants: dict, text: dict, given=()) -> None:
+    """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
+    energy criterion's threshold), before any chunk runs (one row through ``impact.evaluation``)."""
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.impact.quantities import INPUTS
+
+    if not constants and not text:
+        return
+    probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
+    message = probe.messages.text(0)
+    first = message.split(" ", 1)[0]
+    if probe.status[0] != 3 or first in _DEPENDENT_INPUTS:  # 3: invalid
+        return
+    # a refusal naming an input nobody gave is one the constants cause (a threshold the energy criterion needs,
+    # a failure stress the fruit lacks): it would refuse every member
+    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
+        raise InputError(message, first)
+
+
+def _spec_text(value) -> str:
+    """A library value of a sweep axis or a distribution as the CLI's text: numbers by ``repr``, a
+    sequence joined by commas."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (list, tuple)) or (hasattr(value, "__array__") and getattr(value, "ndim", 0) == 1):
+        return ",".join(_spec_text(item) for item in value)
+    if isinstance(value, bool):
+        raise TypeError
+    return repr(float(value))
+
+
+def _texts(inputs: Mapping) -> dict[str, str]:
+    out = {}
+    for name, value in inputs.items():
+        _input(name)
+        if value is None:
+            continue
+        try:
+            out[name] = _spec_text(value)
+        except (TypeError, ValueError):
+            raise InputError(f"{name} must be a number, a text with units or a range; got {value!r}",
+                             name) from None
+    return out
+
+
+# --- batch -----------------------------------------------------------------------------------------------------------
+
+def batch_plan(input, output=None, chunk_size=CHUNK_ROWS) -> Plan:
+    """The plan of ``batch``: the table file ``input`` (CSV or Parquet, streamed) in chunks of ``chunk_size``."""
+    from fruitimpact.runs.sources import TableSource
+
+    chunk_size = read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS)
+    try:
+        source = TableSource.open(input)
+    except ValueError as exc:
+        raise InputError(f"input: {exc}", "input") from None
+    if output and source.path == str(Path(output).resolve()):
+        raise InputError("output must differ from the input file", "output")
+    return Plan("batch", source, chunk_size)
+
+
+def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=2, workdir=None,
+          fresh: bool = False):
+    """Characteristics of every row of a CSV or Parquet file of inputs, into a CSV or Parquet file.
+
+    Parameters
+    ----------
+    input : str or Path
+        Rows of inputs, columns named like :func:`fruitimpact.simulate`'s inputs (``mass`` [kg], ``diameter``
+        [m], ``modulus`` [Pa], ``velocity`` [m/s], ``drop_height`` [m], ``restitution``, ``model``, ...; SI
+        numbers or strings with units; an empty cell takes the default, NaN is invalid).  An unknown column is refused.
+    output : str or Path
+        ``.csv``, ``.parquet`` or ``.pq``: every row with its inputs as used, the characteristics, ``status``,
+        ``message`` and ``warnings``, and the input row number in ``row``.  Written atomically.
+    chunk_size : int or str
+        Rows per chunk, 1 to 10,000,000 (default 500,000); ``"1e6"`` accepted.
+    engine, scheduler, workers, workdir, fresh
+        As :func:`run`: ``"inprocess"`` or ``"dask"``, a Dask scheduler address, local Dask workers, the work
+        folder of the part files, discard another job's parts.
+
+    Returns
+    -------
+    RunSummary
+        Rows per status (``ok``, ``invalid``, ``failed``, ``statuses``), ``output``, ``resumed_chunks``.
+
+    Raises
+    ------
+    ValueError
+        An input file that cannot be read or has unknown columns, an output that cannot be written or is the
+        input, an argument out of range (the message names it).  A bad row never raises: it is ``invalid``.
+    RunError
+        A work folder of another job or in use, an input changed during the run, a failed write (the completed
+        chunks are kept: the same call resumes).
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> summary = fi.batch("examples/batch.csv", "results.parquet")  # doctest: +SKIP
+    >>> summary.ok, summary.invalid  # doctest: +SKIP
+
+    References
+    ----------
+    Each row as :func:`fruitimpact.evaluate` (the founding paper's model, "Theoretical aspects about
+    simulating the reaction to impact of apples on rigid plane surfaces", and the damping laws' sources).
+    """
+    plan = batch_plan(input, output, chunk_size)
+    if output is None:
+        raise InputError("output must be given: a .csv or .parquet file for every row", "output")
+    return run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh)
+
+
+# --- sweep ------------------------------------------------------------------------------------------------------------
+
+def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = True):
+    """(plan, swept axes) of a sweep over ``axes_text`` (input → ``START:STOP:COUNT``, ``log:...``, a comma
+    list or one value, in the order given: the first varies slowest)."""
+    from fruitimpact.runs.sources import Axis, GridSource, parse_axis
+
+    chunk_size = read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS)
+    axes, constants, text = [], {}, {}
+    for name, spec in axes_text.items():
+        try:
+            axis = parse_axis(name, spec)
+        except ValueError as exc:
+            raise InputError(f"{name}: {exc}", name) from None
+        if not axis.numeric:
+            _check_text(name, axis.values)
+        if len(axis.values) > 1:
+            axes.append(axis)
+        elif axis.numeric:
+            constants[name] = axis.values[0]
+        else:
+            text[name] = axis.values[0]
+    _check_conflicts(list(axes_text))
+    _check_constants(constants, text, list(axes_text))
+    points = math.prod(len(a.values) for a in axes)
+    if points > MAX_ROWS:
+        raise InputError(f"the grid has {points:,} points ({' × '.join(str(len(a.values)) for a in axes)}); "
+                         f"a sweep has at most {MAX_ROWS:,}")
+    fixed = [Axis(k, (v,)) for k, v in {**constants, **text}.items()]
+    grid = GridSource(tuple(axes + fixed))
+    return Plan("sweep", grid, chunk_size, write_rows=write_rows), tuple(axes)
+
+
+def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=2, workdir=None,
+          fresh: bool = False, **inputs):
+    """Characteristics over a grid of inputs.
+
+    Parameters
+    ----------
+    output : str or Path, optional
+        A ``.csv`` or ``.parquet`` file for every grid point (a chunked, resumable run, as ``fruitimpact sweep
+        -o``).  Without it the grid (at most 2,000,000 points) is returned as a DataFrame.
+    **inputs
+        Each input of :func:`fruitimpact.evaluate` by name: a range ``"START:STOP:COUNT"`` (inclusive,
+        linear; units allowed, ``"2MPa:6MPa:41"``), ``"log:START:STOP:COUNT"`` (geometric), a list of values
+        (``[0.5, 1.0]``, ``"chen,flores"``) or one value.  The first swept input given varies slowest.
+    chunk_size, engine, scheduler, workers, workdir, fresh
+        As :func:`batch` (with ``output`` only).
+
+    Returns
+    -------
+    pandas.DataFrame or RunSummary
+        Without ``output``: one row per grid point, the columns of :func:`fruitimpact.evaluate`.  With it
+        (as ``pandas.DataFrame.to_csv`` returns nothing once given a path): the ``RunSummary``.
+
+    Raises
+    ------
+    ValueError
+        An unknown input, a bad range (a COUNT that is not an integer in [1, 1,000,000], a log range through
+        0), a constant out of range, conflicting inputs (``velocity`` and ``drop_height``), a grid too large;
+        the message names the argument.  A bad grid point never raises: it is ``invalid``.
+    RunError
+        As :func:`batch`.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> grid = fi.sweep(velocity="0.5:1.5:3", modulus="2MPa,4MPa")
+    >>> grid[["velocity", "modulus", "status"]].shape
+    (6, 3)
+    >>> round(float(grid["restitution"].iloc[0]), 3)
+    0.577
+
+    References
+    ----------
+    Each point as :func:`fruitimpact.evaluate`.
+    """
+    plan, axes = sweep_plan(_texts(inputs), chunk_size)
+    if output is not None:
+        return run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh)
+    if plan.rows > MAX_FRAME_ROWS:
+        raise InputError(f"output must be given for a grid of {plan.rows:,} points (more than {MAX_FRAME_ROWS:,} "
+                         f"are written to a file, not returned)", "output")
+    from fruitimpact.runs.chunks import evaluate_rows
+
+    columns, _ = plan.source.inputs(0, plan.rows, None)
+    return evaluate_rows(columns, 0).frame()  # the rows a chunk of the file run would write
+
+
+# --- population --------------------------------------------------------------------------------------------------------
+
+def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = True, characteristics=None,
+                    thresholds=(), sample_size=SAMPLE_ROWS, chunk_size=CHUNK_ROWS, write_rows: bool = False):
+    """(plan, drawn distributions as (name, Distribution), lines describing the library spreads) of a
+    population; ``inputs``: input → a constant or a distribution text (``"normal(115g,10g)"``)."""
+    from fruitimpact.impact.distributions import Constant, parse_distribution
+    from fruitimpact.impact.lots import PopulationSource
+    from fruitimpact.impact.presets import lot_distributions
+    from fruitimpact.impact.quantities import DEFAULT_SUMMARY
+
+    rows = read_count("rows", rows, 1, MAX_ROWS)
+    seed = read_count("seed", seed, 0)
+    distributions, constants, text = [], {}, {}
+    for name, spec in _texts(inputs).items():
+        quantity = _input(name)
+        if not quantity.numeric:
+            _check_text(name, [spec])
+            text[name] = spec
+            continue
+        try:
+            dist = parse_distribution(spec, quantity.dimension, name)
+        except ValueError as exc:
+            raise InputError(f"{name}: {exc}", name) from None
+        distributions.append((name, dist))
+        if isinstance(dist, Constant):
+            constants[name] = dist.value
+    _check_conflicts([d for d, _ in distributions])
+    _check_constants(constants, text, [d for d, _ in distributions] + list(text))
+    extra, density, described = lot_distributions(text.get("fruit"), [d for d, _ in distributions],
+                                                  text.get("criterion"), spreads=spreads)
+    distributions += list(extra)
+    try:
+        if characteristics is None:
+            names = DEFAULT_SUMMARY
+        elif isinstance(characteristics, str):
+            names = characteristics_list(characteristics)
+        else:
+            names = tuple(characteristic(str(name)).name for name in characteristics)
+    except ValueError as exc:
+        raise InputError(f"characteristics: {exc}", "characteristics") from None
+    parsed = []
+    for item in [thresholds] if isinstance(thresholds, str) else thresholds:
+        try:
+            parsed.append(item if isinstance(item, Threshold) else Threshold.parse(str(item)))
+        except ValueError as exc:
+            raise InputError(f"threshold: {exc}", "threshold") from None
+    source = PopulationSource(tuple(distributions), tuple(text.items()), rows, seed, density)
+    plan = Plan("population", source, read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS), write_rows=write_rows,
+                stats=tuple(names), thresholds=tuple(parsed),
+                sample_rows=read_count("sample_size", sample_size, 1, MAX_SAMPLE_ROWS))
+    return plan, tuple(distributions), tuple(described)
+
+
+def check_percentiles(percentiles) -> tuple[float, ...]:
+    """Percentiles [%], each in [0, 100]: a sequence or a comma list ``"5,50,95"``."""
+    items = percentiles.split(",") if isinstance(percentiles, str) else list(percentiles)
+    try:
+        values = tuple(float(p) for p in items)
+    except (TypeError, ValueError):
+        values = (math.nan,)
+    if not values or not all(0 <= p <= 100 for p in values):
+        raise InputError(f"percentiles: each must be a number in [0, 100]; got {percentiles!r}", "percentiles")
+    return values
+
+
+def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=None, percentiles=PERCENTILES,
+               thresholds=(), sample_size=SAMPLE_ROWS, output=None, chunk_size=CHUNK_ROWS, engine=None,
+               scheduler=None, workers=2, workdir=None, fresh: bool = False, **inputs):
+    """A Monte Carlo population of impacts: statistics, percentiles and threshold shares.
+
+    Parameters
+    ----------
+    rows : int or str
+        Members, 1 to 1,000,000,000 (``"1e7"`` accepted).
+    seed : int or str
+        Random seed ≥ 0, exact: the same call gives the same members, for any chunk size or engine.
+    spreads : bool
+        Draw the inputs not given from the fruit's library spreads (a real lot varies); False: identical fruit.
+    characteristics : str or sequence of str, optional
+        Characteristics summarised (default: all twelve).
+    percentiles : sequence of float or str
+        Percentiles [%] (default 5, 25, 50, 75, 95).
+    thresholds : sequence of str
+        Members beyond a threshold, counted exactly, e.g. ``"peak_force>60N"`` (>, >=, <, <=).
+    sample_size : int
+        Percentiles are exact up to this many members, above it estimated from a seeded uniform sample.
+    output : str or Path, optional
+        Also write every member's row (CSV or Parquet).
+    chunk_size, engine, scheduler, workers, workdir, fresh
+        As :func:`batch`.
+    **inputs
+        Each input a constant (``mass=0.115``, ``"115g"``) or a distribution: ``"normal(mean,sd)"``,
+        ``"lognormal(median,sigma)"``, ``"uniform(lo,hi)"``, ``"truncnormal(mean,sd,lo,hi)"``,
+        ``"sample(FILE[:COLUMN])"`` (units allowed inside).
+
+    Returns
+    -------
+    RunSummary
+        ``statistics`` (per characteristic: mean, sd, min, max, percentiles [SI]), ``thresholds`` (count, of,
+        share), ``percentiles`` (the method), status counts; ``to_dict()`` is ``fruitimpact population
+        --json`` (with ``seed``, ``inputs`` and ``spreads``).
+
+    Raises
+    ------
+    ValueError
+        An unknown input, a distribution or constant out of range, conflicting inputs, a bad threshold or
+        percentile; the message names the argument.
+    RunError
+        As :func:`batch`.
+
+    Examples
+    --------
+    >>> import fruitimpact as fi
+    >>> lot = fi.population(2000, fruit="apple", drop_height="uniform(5cm,30cm)", criterion="shear",
+    ...                     thresholds=["peak_force>60N"])
+    >>> lot.ok, sorted(lot.statistics)[:2]
+    (2000, ['absorbed_energy', 'contact_duration'])
+
+    References
+    ----------
+    Each member as :func:`fruitimpact.evaluate`; the lot spreads: docs/library.md.
+    """
+    plan, distributions, described = population_plan(
+        inputs, rows=rows, seed=seed, spreads=spreads, characteristics=characteristics, thresholds=thresholds,
+        sample_size=sample_size, chunk_size=chunk_size, write_rows=output is not None)
+    percentiles = check_percentiles(percentiles)
+    summary = run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh,
+                  percentiles=percentiles)
+    summary.details = {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in distributions},
+                       "spreads": list(described)}
+    return summary
+
+
+__all__ = ["MAX_FRAME_ROWS", "MAX_WORKERS", "batch", "batch_plan", "check_percentiles", "check_run", "population",
+           "population_plan", "run", "sweep", "sweep_plan"]
