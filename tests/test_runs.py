@@ -244,9 +244,9 @@ def test_population_text_report_and_histograms(tmp_path, cli):
 
 # --------------------------------------------------------------------------- resume
 class Interrupt:
-    """Stand-in for runs.chunks.run_chunk that raises KeyboardInterrupt (Ctrl-C) after ``chunks`` chunks."""
+    """Stand-in for runs.chunks.compute_chunk that raises KeyboardInterrupt (Ctrl-C) after ``chunks`` chunks."""
 
-    real = staticmethod(runs.run_chunk)
+    real = staticmethod(runs.chunks.compute_chunk)
 
     def __init__(self, chunks):
         self.chunks = chunks
@@ -262,14 +262,14 @@ def test_interrupted_population_resumes_to_identical_output(tmp_path, monkeypatc
     full, _ = population(tmp_path, cli, "full.parquet", rows=7000, chunk=1000)
     out = tmp_path / "resumed.parquet"
     argv = (*POP, "-n", 7000, "--chunk-size", 1000, "-o", out, "--json")
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(3))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(3))
     status, _, err = cli.run(*argv)
     assert status == 130 and "interrupted" in err and "resume" in err
     parts = tmp_path / "resumed.parquet.parts"
     assert len(list(parts.glob("part-*.arrow"))) == 3 and not out.exists()
     stale = parts / ".part-0000009.arrow.fruitimpact-tmp-1-deadbeef"
     stale.write_bytes(b"half a chunk")  # killed while writing
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(2))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(2))
     assert cli.run(*argv)[0] == 130
     assert len(list(parts.glob("part-*.arrow"))) == 5 and not stale.exists()
     monkeypatch.undo()
@@ -285,7 +285,7 @@ def test_deleted_parts_are_recomputed(tmp_path, cli, monkeypatch):
     source = tmp_path / "in.csv"
     pd.DataFrame({"velocity": np.linspace(0.2, 2.0, 50), "mass": ["100g"] * 50}).to_csv(source, index=False)
     cli.ok("batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(6))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(6))
     assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     parts = tmp_path / "out.csv.parts"
@@ -298,7 +298,7 @@ def test_deleted_parts_are_recomputed(tmp_path, cli, monkeypatch):
 
 def test_work_directory_of_another_job_is_refused(tmp_path, cli, monkeypatch):
     out = tmp_path / "pop.parquet"
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(1))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(1))
     assert cli.run(*POP, "-n", 3000, "--chunk-size", 1000, "-o", out)[0] == 130
     monkeypatch.undo()
     for changed in (("--seed", 8), ("-n", 4000), ("--chunk-size", 500), ("--mass", "normal(116g,10g)")):

@@ -20,9 +20,9 @@ from fruitimpact.impact.quantities import DEFAULT_SUMMARY
 
 
 class Interrupt:
-    """Stand-in for runs.chunks.run_chunk that raises KeyboardInterrupt after ``chunks`` chunks."""
+    """Stand-in for runs.chunks.compute_chunk that raises KeyboardInterrupt after ``chunks`` chunks."""
 
-    real = staticmethod(runs.chunks.run_chunk)
+    real = staticmethod(runs.chunks.compute_chunk)
 
     def __init__(self, chunks):
         self.chunks = chunks
@@ -77,7 +77,7 @@ def test_output_inside_the_work_folder_survives_cleanup(tmp_path, cli):
 
 def test_user_files_in_our_work_folder_are_kept(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(2))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(2))
     assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     (tmp_path / "out.csv.parts" / "mine.txt").write_text("keep me")
@@ -106,7 +106,7 @@ def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, 
 def test_damaged_parts_are_recomputed(tmp_path, cli, monkeypatch, damage):
     source = velocities_csv(tmp_path / "in.csv")
     cli.ok("batch", source, "-o", tmp_path / "full.csv", "--chunk-size", 7)
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(5))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(5))
     assert cli.run("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     parts = tmp_path / "out.csv.parts"
@@ -129,7 +129,7 @@ def test_damaged_parts_are_recomputed(tmp_path, cli, monkeypatch, damage):
 
 def test_manifest_records_row_ranges_and_hashes(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(3))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(3))
     assert cli.run("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)[0] == 130
     lines = [json.loads(line) for line in (tmp_path / "out.parquet.parts" / "manifest.jsonl").read_text().splitlines()]
     assert "fingerprint" in lines[0]
@@ -139,7 +139,7 @@ def test_manifest_records_row_ranges_and_hashes(tmp_path, cli, monkeypatch):
 
 def test_an_input_file_changed_during_the_run_is_refused(tmp_path, cli, monkeypatch):
     source = velocities_csv(tmp_path / "in.csv")
-    real = runs.chunks.run_chunk
+    real = runs.chunks.compute_chunk
 
     def edit_after_first(plan, index, *args, **kwargs):
         result = real(plan, index, *args, **kwargs)
@@ -148,7 +148,7 @@ def test_an_input_file_changed_during_the_run_is_refused(tmp_path, cli, monkeypa
                 handle.write("1.5,120g\n")
         return result
 
-    monkeypatch.setattr(runs.chunks, "run_chunk", edit_after_first)
+    monkeypatch.setattr(runs.chunks, "compute_chunk", edit_after_first)
     line = cli.error("batch", source, "-o", tmp_path / "out.csv", "--chunk-size", 7)
     assert "changed during the run" in line and "--fresh" in line
     assert not (tmp_path / "out.csv").exists()
@@ -165,7 +165,7 @@ def test_a_second_run_on_the_same_output_or_work_folder_is_refused(tmp_path, cli
         assert "in use by another fruitimpact run" in line and f"pid {os.getpid()}" in line
     finally:
         held.release(remove=True)
-    monkeypatch.setattr(runs.chunks, "run_chunk", Interrupt(1))
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(1))
     assert cli.run("batch", source, "-o", out, "--chunk-size", 7)[0] == 130
     monkeypatch.undo()
     held = runs.locking.RunLock(tmp_path / "out.csv.parts" / ".fruitimpact-lock", "work folder").acquire()

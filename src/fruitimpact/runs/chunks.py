@@ -84,17 +84,28 @@ def run_chunk(plan, index: int, payload, workdir: str, numba_threads: int | None
         import numba
 
         numba.set_num_threads(min(numba_threads, numba.config.NUMBA_NUM_THREADS))
+    return store_chunk(plan, compute_chunk(plan, index, payload), workdir, keep_rows)
+
+
+def compute_chunk(plan, index: int, payload) -> dict:
+    """The computing half of ``run_chunk``: the chunk's ``record`` (without its files yet), ``summary`` and
+    ``table`` (its rows, when the run keeps rows); no file is touched."""
     start = index * plan.chunk_rows
     stop = start + plan.chunk_rows if plan.rows is None else min(start + plan.chunk_rows, plan.rows)
     inputs, errors = plan.source.inputs(start, stop, payload)
     result = evaluate_rows(inputs, start, errors)
-    summary = summarise(plan, result, start)
     record = {"chunk": index, "start": start, "rows": result.rows, "statuses": result.status_counts(),
               "part": None, "summary": None}
-    table = None
-    if plan.write_rows:
-        table = result.table(start)
-        record["part"] = write_part(workdir, index, table)
+    return {"record": record, "summary": summarise(plan, result, start),
+            "table": result.table(start) if plan.write_rows else None}
+
+
+def store_chunk(plan, computed: dict, workdir: str, keep_rows: bool = False) -> dict:
+    """The writing half of ``run_chunk``: the part and summary files of a ``compute_chunk`` result, entered
+    (name, size, SHA-256) in its record; the rows are dropped unless ``keep_rows``."""
+    record, summary, table = computed["record"], computed["summary"], computed["table"]
+    if table is not None:
+        record["part"] = write_part(workdir, record["chunk"], table)
     if summary is not None:
-        record["summary"] = write_summary(workdir, index, summary)
+        record["summary"] = write_summary(workdir, record["chunk"], summary)
     return {"record": record, "summary": summary, "table": table if keep_rows else None}

@@ -27,15 +27,34 @@ def check_scheduler(address: str) -> str:
 @dataclass(frozen=True)
 class InProcessEngine:
     """Chunks one after the other in this process (the compiled kernels use every core); each
-    chunk's rows come back to the driver, which writes them straight into the output."""
+    chunk's rows come back to the driver, which writes them straight into the output.
+
+    Writing overlaps computing: while chunk i+1 is read and evaluated, one writer thread stores chunk
+    i (its part file, hashed as written) and hands it to ``done`` (the manifest line, then the rows
+    into the output), so ``done`` runs in that thread, in chunk order, one chunk at a time.  pyarrow
+    and hashlib release the GIL while they write and hash.  At most one chunk is in flight in each
+    half; an error in the writer (a full disk) is raised here at the next chunk, and an interruption
+    waits for the chunk being written, which is then complete and kept."""
 
     name = "inprocess"
 
     def run(self, plan, payloads, workdir: str, done) -> None:
-        from fruitimpact.runs.chunks import run_chunk  # here: the CLI parser reads ENGINES cheaply
+        from concurrent.futures import ThreadPoolExecutor
 
-        for index, payload in payloads:
-            done(run_chunk(plan, index, payload, workdir, keep_rows=True))
+        from fruitimpact.runs.chunks import compute_chunk, store_chunk  # here: the CLI parser reads ENGINES cheaply
+
+        def store(computed):
+            done(store_chunk(plan, computed, workdir, keep_rows=True))
+
+        with ThreadPoolExecutor(1, thread_name_prefix="fruitimpact-writer") as writer:
+            writing = None
+            for index, payload in payloads:
+                computed = compute_chunk(plan, index, payload)
+                if writing is not None:
+                    writing.result()  # the previous chunk is stored (or its error raised) before the next starts
+                writing = writer.submit(store, computed)
+            if writing is not None:
+                writing.result()
 
 
 @dataclass(frozen=True)
