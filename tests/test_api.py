@@ -181,6 +181,9 @@ def test_sweep_agrees_with_the_cli(cli, tmp_path):
     # to a file, the function is the command: the same rows
     summary = fi.sweep(tmp_path / "api.csv", velocity="0.5:1.5:3", model="chen,flores", fruit="pear")
     assert summary.rows == 6 and pd.read_csv(tmp_path / "api.csv").equals(written)
+    # a run option without a file would be ignored: refused instead
+    with pytest.raises(ValueError, match="engine applies to a run into a file"):
+        fi.sweep(velocity="0.5:1.5:3", engine="dask")
 
 
 def test_population_agrees_with_the_cli(cli, tmp_path, monkeypatch):

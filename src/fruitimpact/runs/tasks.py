@@ -212,9 +212,9 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
     Each row as :func:`fruitimpact.evaluate` (the founding paper's model, "Theoretical aspects about
     simulating the reaction to impact of apples on rigid plane surfaces", and the damping laws' sources).
     """
-    plan = batch_plan(input, output, chunk_size)
     if output is None:
         raise InputError("output must be given: a .csv or .parquet file for every row", "output")
+    plan = batch_plan(input, output, chunk_size)
     return run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh)
 
 
@@ -298,6 +298,12 @@ def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, wo
     plan, axes = sweep_plan(_texts(inputs), chunk_size)
     if output is not None:
         return run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh)
+    asked = {"engine": engine is not None, "scheduler": scheduler is not None, "workers": workers != 2,
+             "workdir": workdir is not None, "fresh": bool(fresh)}
+    for name, given in asked.items():
+        if given:  # a run option without a run would be silently ignored
+            raise InputError(f"{name} applies to a run into a file: give output (a .csv or .parquet file) with it, "
+                             f"or leave {name} out for a DataFrame", name)
     if plan.rows > MAX_FRAME_ROWS:
         raise InputError(f"output must be given for a grid of {plan.rows:,} points (more than {MAX_FRAME_ROWS:,} "
                          f"are written to a file, not returned)", "output")
