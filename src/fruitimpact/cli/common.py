@@ -79,6 +79,21 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size"}
 
 
+def check_outputs(*outputs) -> None:
+    """Each ``(option, path, formats)`` whose path is given: a file that can be written, of one of ``formats``
+    (``impact.outputs.check_output``), before any work; a figure (``FIGURE_FORMATS``) also needs matplotlib."""
+    import importlib.util
+
+    from fruitimpact.impact.outputs import FIGURE_FORMATS, check_output
+
+    for option, path, formats in outputs:
+        if path is None:
+            continue
+        _library_call(check_output, path, option, formats)
+        if formats is FIGURE_FORMATS and importlib.util.find_spec("matplotlib") is None:
+            raise UsageError(f"argument {option}: figures need matplotlib: pip install 'fruitimpact[plot]'")
+
+
 def _library_call(func, *args, **kwargs):
     """Run a library call, turning its ValueError into the CLI's one-line error."""
     try:

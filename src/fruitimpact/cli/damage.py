@@ -6,7 +6,8 @@ import math
 import sys
 
 from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs,
-                                    add_spread_option, dump_json, print_spreads)
+                                    add_spread_option, check_outputs, dump_json, print_spreads)
+from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS
 from fruitimpact.impact.quantities import INPUTS, OUTPUTS
 
 
@@ -16,17 +17,6 @@ def _without_velocity(args) -> dict:
         if name in kwargs:
             raise UsageError(f"argument --{name}: the {args.command} command sets the velocity from the drop height")
     return kwargs
-
-
-def _check_outputs(pairs) -> None:
-    from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
-
-    for option, path, kind in pairs:
-        if path is not None:
-            try:
-                check_output(path, option, CSV_FORMAT if kind == "csv" else FIGURE_FORMATS)
-            except ValueError as exc:
-                raise UsageError(str(exc)) from None
 
 
 def _print_warnings(command: str, warnings) -> None:
@@ -82,7 +72,7 @@ def cmd_safe_height(args) -> int:
     kwargs = _without_velocity(args)
     if "drop_height" in kwargs:
         raise UsageError("argument --drop-height: safe-height finds the drop height; leave it out")
-    _check_outputs([("--map-csv", args.map_csv, "csv"), ("--plot", args.plot, "figure")])
+    check_outputs(("--map-csv", args.map_csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
     if (args.map_csv or args.plot) and not args.map:
         args.map = "surface"
     report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
@@ -145,7 +135,7 @@ def cmd_line(args) -> int:
         points = read_line(args.line)
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
-    _check_outputs([("--plot", args.plot, "figure")])
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     given = {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
              if getattr(args, quantity.name, None) is not None}
     report = _library_call(audit_line, points, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,

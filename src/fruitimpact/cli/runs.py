@@ -8,11 +8,11 @@ its allowed range, exit status 2.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
 
-from fruitimpact.cli.common import (PROG, UsageError, _library_call, _Ordered, add_spread_option, dump_json,
-                                    print_spreads, usage_message)
+from fruitimpact.cli.common import (PROG, UsageError, _library_call, _Ordered, add_spread_option, check_outputs,
+                                    dump_json, print_spreads, usage_message)
+from fruitimpact.impact.outputs import FIGURE_FORMATS
 
 def _run_inputs():
     """(option, name, quantity) of every input of the table of quantities, numeric first."""
@@ -44,30 +44,8 @@ def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> 
                             "made and marked) instead of resuming")
 
 
-def _check_output(option: str, path, formats) -> None:
-    """``outputs.check_output`` as a one-line UsageError (an OSError of the file system too)."""
-    from fruitimpact.impact.outputs import check_output
-
-    try:
-        check_output(path, option, formats)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    except OSError as exc:  # e.g. a name too long to even look up
-        raise UsageError(f"argument {option}: cannot write {str(path)!r}: {exc.strerror}") from None
-
-
-def _check_figure(option: str, path) -> None:
-    """A figure path is writable and matplotlib is there, before any work."""
-    from fruitimpact.impact.outputs import FIGURE_FORMATS
-
-    if path is None:
-        return
-    _check_output(option, path, FIGURE_FORMATS)
-    if importlib.util.find_spec("matplotlib") is None:
-        raise UsageError(f"argument {option}: figures need matplotlib: pip install 'fruitimpact[plot]'")
-
-
 def _run_options(args) -> dict:
+    """The run options of ``args`` as ``runs.tasks.check_run`` names them."""
     return dict(engine=args.engine, scheduler=args.scheduler, workers=args.workers, workdir=args.workdir)
 
 
@@ -77,17 +55,16 @@ def _run(args, plan, keep_columns=(), percentiles=None):
     from fruitimpact import runs
     from fruitimpact.runs import tasks
 
-    options = _run_options(args)
-    _, workdir = _library_call(tasks.check_run, plan, args.output, **options)
+    checked = _library_call(tasks.check_run, plan, args.output, **_run_options(args))
     try:
-        return tasks.run(plan, args.output, fresh=args.fresh, keep_columns=keep_columns,
-                         percentiles=percentiles or runs.PERCENTILES, **options)
+        return tasks.start(plan, args.output, checked, fresh=args.fresh, keep_columns=keep_columns,
+                           percentiles=percentiles or runs.PERCENTILES)
     except ValueError as exc:
         raise UsageError(usage_message(exc)) from None
     except runs.RunError as exc:
         raise UsageError(str(exc)) from None
     except KeyboardInterrupt:
-        print(f"{PROG} {args.command}: interrupted; completed chunks are kept in {workdir}: "
+        print(f"{PROG} {args.command}: interrupted; completed chunks are kept in {checked[1]}: "
               f"run the same command again to resume", file=sys.stderr)
         return None
 
@@ -128,7 +105,7 @@ def cmd_sweep(args) -> int:
                          + (f" ({', '.join(a.name for a in axes)})" if axes else " (give START:STOP:COUNT)"))
     if not (args.output or args.plot):
         raise UsageError("argument -o/--output: give -o OUT and/or --plot FILE")
-    _check_figure("--plot", args.plot)
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     summary = _run(args, plan, keep_columns=(name,) if args.plot else ())
     if summary is None:
         return 130
@@ -175,17 +152,16 @@ def cmd_population(args) -> int:
     from fruitimpact.runs import tasks
 
     inputs = {dest: getattr(args, dest) for _, dest, _ in _run_inputs() if getattr(args, dest) is not None}
-    plan, distributions, spread_lines = _library_call(
+    percentiles = _library_call(tasks.check_percentiles, args.percentiles)
+    plan, spread_lines = _library_call(
         tasks.population_plan, inputs, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
         characteristics=args.characteristics, thresholds=args.threshold or (), sample_size=args.sample_size,
         chunk_size=args.chunk_size, write_rows=args.output is not None)
-    percentiles = _library_call(tasks.check_percentiles, args.percentiles)
-    _check_figure("--hist", args.hist)
+    check_outputs(("--hist", args.hist, FIGURE_FORMATS))
     summary = _run(args, plan, percentiles=percentiles)
     if summary is None:
         return 130
-    summary.details = {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in distributions},
-                       "spreads": list(spread_lines)}
+    summary.details = tasks.population_details(plan, spread_lines)
     names = plan.stats
     if args.hist:
         _save("--hist", runs.histogram_figure(summary.sample, names, summary.percentiles["exact"]), args.hist)

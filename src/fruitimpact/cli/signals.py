@@ -7,7 +7,8 @@ import json
 import math
 import sys
 
-from fruitimpact.cli.common import PROG, UsageError, _library_call, dump_json
+from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json
+from fruitimpact.impact.outputs import FIGURE_FORMATS
 from fruitimpact.impact.units import parse_quantity
 
 
@@ -122,13 +123,7 @@ def cmd_analyze(args) -> int:
     lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
     if lanes is None:
         raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
-    if args.plot:
-        from fruitimpact.impact.outputs import FIGURE_FORMATS, check_output
-
-        try:
-            check_output(args.plot, "--plot", FIGURE_FORMATS)
-        except ValueError as exc:
-            raise UsageError(str(exc)) from None
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
     from fruitimpact.signals import offline

@@ -6,7 +6,9 @@ import math
 import sys
 
 from fruitimpact.impact.quantities import CHARACTERISTIC_NAMES, CHARACTERISTICS, OUTPUTS
-from fruitimpact.cli.common import PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs, dump_json
+from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs,
+                                    check_outputs, dump_json)
+from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS
 
 
 def _law_line(law) -> str:
@@ -84,24 +86,12 @@ def _overlays(args) -> list[dict]:
     return overlays
 
 
-def _check_outputs(args) -> None:
-    """Every output path and format, before the impact is computed."""
-    from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS, check_output
-
-    for option, path, formats in (("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS)):
-        if path is not None:
-            try:
-                check_output(path, option, formats)
-            except ValueError as exc:
-                raise UsageError(str(exc)) from None
-
-
 def cmd_simulate(args) -> int:
     from fruitimpact.impact.simulation import simulate
 
     kwargs = _simulate_kwargs(args)
     overlays = _overlays(args)
-    _check_outputs(args)
+    check_outputs(("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
     result = _library_call(simulate, **kwargs)
     for warning in result.warnings:
         print(f"{PROG} simulate: warning: {warning}", file=sys.stderr)

@@ -122,19 +122,18 @@ def check_output(path, argument: str, formats: dict[str, str] | None = None) -> 
     if formats is not None:
         output_format(path, argument, formats)
     folder = path.parent
-    limit = _name_max(folder if folder.is_dir() else Path("."))
-    if len(path.name.encode()) + _TMP_ROOM > limit:
-        raise output_error(argument, path, f"the file name is longer than this file system allows "
-                                           f"({limit} bytes, with room for a temporary suffix)")
-    try:
-        is_folder = path.is_dir()
+    try:  # the file system's own refusals (a name too long even to look up, no permission) as the same one line
+        limit = _name_max(folder if folder.is_dir() else Path("."))
+        if len(path.name.encode()) + _TMP_ROOM > limit:
+            raise output_error(argument, path, f"the file name is longer than this file system allows "
+                                               f"({limit} bytes, with room for a temporary suffix)")
+        if path.is_dir():
+            raise output_error(argument, path, "it is a folder; give a file name")
+        check_folder(folder, argument, path)
+        if path.exists() and not os.access(path, os.W_OK):
+            raise output_error(argument, path, "the file exists and is read-only")
     except OSError as exc:
         raise output_error(argument, path, _reason(exc, folder)) from None
-    if is_folder:
-        raise output_error(argument, path, "it is a folder; give a file name")
-    check_folder(folder, argument, path)
-    if path.exists() and not os.access(path, os.W_OK):
-        raise output_error(argument, path, "the file exists and is read-only")
     return path
 
 

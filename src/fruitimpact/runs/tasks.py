@@ -41,8 +41,6 @@ def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, work
     if output is not None:
         try:
             check_output(output, "output", TABLE_FORMATS)
-        except OSError as exc:  # e.g. a name too long to even look up
-            raise InputError(f"output: cannot write {str(output)!r}: {exc.strerror}", "output") from None
         except ValueError as exc:
             raise InputError(str(exc), "output") from None
     workers = read_count("workers", workers, 1, MAX_WORKERS)
@@ -72,10 +70,17 @@ def run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=No
         keep_columns=(), percentiles=PERCENTILES):
     """Execute ``plan`` (``runs.execute``) after ``check_run``; returns the ``RunSummary``.  ``fresh`` discards
     the parts of another job in the work folder (only a folder fruitimpact made and marked)."""
+    checked = check_run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir)
+    return start(plan, output, checked, fresh=fresh, keep_columns=keep_columns, percentiles=percentiles)
+
+
+def start(plan, output, checked, *, fresh: bool = False, keep_columns=(), percentiles=PERCENTILES):
+    """``run`` once ``check_run`` has answered ``checked`` (engine, work folder), for a caller that needs the
+    work folder before the run starts (the CLI names it when interrupted)."""
     from fruitimpact.runs.driver import execute
 
-    chosen, folder = check_run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir)
-    return execute(plan, output, engine=chosen, workdir=folder, fresh=fresh, keep_columns=keep_columns,
+    engine, folder = checked
+    return execute(plan, output, engine=engine, workdir=folder, fresh=fresh, keep_columns=keep_columns,
                    percentiles=percentiles)
 
 
@@ -112,13 +117,14 @@ def _check_constants(constants: dict, text: dict, given=()) -> None:
     energy criterion's threshold), before any chunk runs (one row through ``impact.evaluation``)."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.quantities import INPUTS
+    from fruitimpact.impact.status import INVALID
 
     if not constants and not text:
         return
     probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
     message = probe.messages.text(0)
     first = message.split(" ", 1)[0]
-    if probe.status[0] != 3 or first in _DEPENDENT_INPUTS:  # 3: invalid
+    if probe.status[0] != INVALID or first in _DEPENDENT_INPUTS:
         return
     # a refusal naming an input nobody gave is one the constants cause (a threshold the energy criterion needs,
     # a failure stress the fruit lacks): it would refuse every member
@@ -317,8 +323,8 @@ def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, wo
 
 def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = True, characteristics=None,
                     thresholds=(), sample_size=SAMPLE_ROWS, chunk_size=CHUNK_ROWS, write_rows: bool = False):
-    """(plan, drawn distributions as (name, Distribution), lines describing the library spreads) of a
-    population; ``inputs``: input → a constant or a distribution text (``"normal(115g,10g)"``)."""
+    """(plan, lines describing the library spreads) of a population; ``inputs``: input → a constant or a
+    distribution text (``"normal(115g,10g)"``).  The drawn distributions are ``plan.source.distributions``."""
     from fruitimpact.impact.distributions import Constant, parse_distribution
     from fruitimpact.impact.lots import PopulationSource
     from fruitimpact.impact.presets import lot_distributions
@@ -364,7 +370,7 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
     plan = Plan("population", source, read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS), write_rows=write_rows,
                 stats=tuple(names), thresholds=tuple(parsed),
                 sample_rows=read_count("sample_size", sample_size, 1, MAX_SAMPLE_ROWS))
-    return plan, tuple(distributions), tuple(described)
+    return plan, tuple(described)
 
 
 def check_percentiles(percentiles) -> tuple[float, ...]:
@@ -436,16 +442,22 @@ def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=Non
     ----------
     Each member as :func:`fruitimpact.evaluate`; the lot spreads: docs/library.md.
     """
-    plan, distributions, described = population_plan(
+    percentiles = check_percentiles(percentiles)
+    plan, described = population_plan(
         inputs, rows=rows, seed=seed, spreads=spreads, characteristics=characteristics, thresholds=thresholds,
         sample_size=sample_size, chunk_size=chunk_size, write_rows=output is not None)
-    percentiles = check_percentiles(percentiles)
     summary = run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh,
                   percentiles=percentiles)
-    summary.details = {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in distributions},
-                       "spreads": list(described)}
+    summary.details = population_details(plan, described)
     return summary
 
 
+def population_details(plan, described) -> dict:
+    """What a population run was asked, for its summary (``RunSummary.details``): the seed, each drawn input's
+    distribution and the lines describing the library spreads."""
+    return {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in plan.source.distributions},
+            "spreads": list(described)}
+
+
 __all__ = ["MAX_FRAME_ROWS", "MAX_WORKERS", "batch", "batch_plan", "check_percentiles", "check_run", "population",
-           "population_plan", "run", "sweep", "sweep_plan"]
+           "population_details", "population_plan", "run", "start", "sweep", "sweep_plan"]
