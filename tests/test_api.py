@@ -115,6 +115,12 @@ def test_analyze_agrees_with_the_cli(cli, recording):
                 assert row[key] == pytest.approx(value, rel=1e-12), key
     from_array = fi.analyze(force, rate=rate, fit=True, drop_height="4cm")
     assert from_array["peak_force"].tolist() == pytest.approx(table["peak_force"].tolist(), rel=1e-12)
+    # and both against the pulses the recording holds: onsets at 0.05 s and 0.25 s, each pulse's own F_max and T
+    # (the fit restores the peak between samples to 1e-4 at 20 kHz and 0.02 N noise; 0.5 % allows a coarser fit)
+    truth = [fi.simulate(fruit="apple", drop_height=h).characteristics for h in ("3cm", "6cm")]
+    assert table["start_time"].tolist() == pytest.approx([0.05, 0.25], abs=2.0 / rate)
+    assert table["peak_force"].tolist() == pytest.approx([c.peak_force for c in truth], rel=5e-3)
+    assert table["contact_duration"].tolist() == pytest.approx([c.contact_duration for c in truth], rel=5e-3)
 
 
 def test_analyze_refuses_like_the_cli(cli, recording):
@@ -136,6 +142,8 @@ def test_classes_agree_with_the_cli(cli, tmp_path):
     report = cli.json("classes", path, "--classes", "soft,firm")
     classes = fi.calibrate_classes([v for v, _ in rows], [c for _, c in rows], ("soft", "firm"), "firmness_c_star")
     assert report["thresholds"] == pytest.approx(list(classes.thresholds), rel=1e-12)
+    # the separable set's threshold lies midway between its softest firm and firmest soft fruit (signals.sort)
+    assert list(classes.thresholds) == pytest.approx([3e5], rel=1e-12)
 
 
 def test_fruits_and_surfaces_agree_with_the_cli(cli):
@@ -147,7 +155,7 @@ def test_evaluate_agrees_with_batch(cli, tmp_path):
     table = tmp_path / "in.csv"
     table.write_text("fruit,drop_height,surface\napple,2cm,steel\npear,10cm,wood\napple,-1,steel\n")
     out = tmp_path / "out.csv"
-    status, _, err = cli.run("batch", table, "-o", out)
+    cli.ok("batch", table, "-o", out)
     import pandas as pd
 
     written = pd.read_csv(out)
@@ -163,7 +171,7 @@ def test_batch_agrees_with_the_cli(cli, tmp_path):
     table.write_text("fruit,drop_height,surface\napple,2cm,steel\npear,10cm,wood\napple,-1,steel\n")
     import pandas as pd
 
-    cli.run("batch", table, "-o", tmp_path / "cli.csv")
+    cli.ok("batch", table, "-o", tmp_path / "cli.csv")
     summary = fi.batch(table, tmp_path / "api.csv")
     assert (summary.ok, summary.invalid, summary.rows) == (2, 1, 3)
     assert pd.read_csv(tmp_path / "api.csv").equals(pd.read_csv(tmp_path / "cli.csv"))
@@ -172,7 +180,7 @@ def test_batch_agrees_with_the_cli(cli, tmp_path):
 def test_sweep_agrees_with_the_cli(cli, tmp_path):
     import pandas as pd
 
-    cli.run("sweep", "--velocity", "0.5:1.5:3", "--model", "chen,flores", "--fruit", "pear", "-o", tmp_path / "g.csv")
+    cli.ok("sweep", "--velocity", "0.5:1.5:3", "--model", "chen,flores", "--fruit", "pear", "-o", tmp_path / "g.csv")
     written = pd.read_csv(tmp_path / "g.csv")
     grid = fi.sweep(velocity="0.5:1.5:3", model=["chen", "flores"], fruit="pear")
     assert written["velocity"].tolist() == grid["velocity"].tolist() == [0.5, 0.5, 1.0, 1.0, 1.5, 1.5]
@@ -233,9 +241,33 @@ SYNTH_LOT = dict(interval=0.25, mass="115g", diameter="65mm", modulus="3MPa", po
                  classes={"soft": 2.5e6, "medium": 3.5e6, "firm": math.inf})
 
 
+@pytest.mark.parametrize("options", [{}, {"fit": True, "drop_height": "5cm"},
+                                     {"classes": "soft,firm", "sort_by": "firmness_c", "thresholds": "30000"}])
+def test_analyze_has_the_same_columns_for_any_recording(options):
+    """A table's columns do not depend on what a recording holds: every report's keys, as the push-style
+    analyzer builds them, are columns and come in the table's order; a quiet recording gives the same columns."""
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.options import analysis_settings
+
+    recording, _ = fi.synthesize(fi.SensorModel(seed=1, noise=0.01), fi.Population(count=2, seed=2, **SYNTH_LOT))
+    table = fi.analyze(recording, **options)
+    quiet = fi.analyze(np.zeros(20_000), rate=recording.rate, **options)
+    assert len(table) >= 2 and len(quiet) == 0
+    assert list(quiet.columns) == list(table.columns)
+    settings, analysis = analysis_settings(recording.rate, True, **options)
+    analyzer = fi.StreamAnalyzer(recording.rate, 1, settings, analysis=analysis)
+    analyzer.feed(np.asarray(recording.lanes["lane0"]))
+    analyzer.close()
+    columns = list(table.columns)
+    for report in map(public, analyzer.results):
+        keys = list(report)
+        assert set(keys) <= set(columns), set(keys) - set(columns)
+        assert keys == sorted(keys, key=columns.index), "a report's keys in another order than the table's"
+
+
 def test_synthesize_agrees_with_synth(cli, tmp_path):
     """The same arguments give the same samples and the same truth."""
-    cli.run("synth", "-o", tmp_path / "cli.npy", "--seed", "3", "--count", "4")
+    cli.ok("synth", "-o", tmp_path / "cli.npy", "--seed", "3", "--count", "4")
     recording, truth = fi.synthesize(fi.SensorModel(seed=3, noise=0.01), fi.Population(count=4, seed=4, **SYNTH_LOT))
     written = fi.read_recording(tmp_path / "cli.npy", rate=recording.rate)
     assert np.array_equal(written.lanes["lane0"], recording.lanes["lane0"])
@@ -243,10 +275,26 @@ def test_synthesize_agrees_with_synth(cli, tmp_path):
     assert [i["peak_force"] for i in cli_truth["impacts"]] == [i["peak_force"] for i in truth["impacts"]]
 
 
+@pytest.mark.parametrize("option", ["--velocity", "--alpha"])
+def test_synth_takes_the_alternative_of_a_defaulted_input(cli, tmp_path, option):
+    """--velocity replaces the default drop height and --alpha the default restitution (both were refused as
+    conflicting with their own defaults).  Hunt–Crossley's restitution depends on α V alone (x = 1.5 α V, the
+    founding paper's eq 5), so one simulate() at that α and speed is the reference for every fruit of the lot."""
+    value = {"--velocity": "1.2", "--alpha": "0.2"}[option]
+    cli.ok("synth", "-o", tmp_path / "r.csv", "--count", "3", "--rebounds", "0", option, value)
+    impacts = json.loads((tmp_path / "r.truth.json").read_text())["impacts"]
+    if option == "--velocity":
+        assert [i["velocity"] for i in impacts] == pytest.approx([1.2] * 3, rel=1e-12)
+    else:
+        expected = fi.simulate(alpha=0.2, drop_height="5cm").characteristics.restitution
+        assert [i["restitution"] for i in impacts] == pytest.approx([expected] * 3, rel=1e-9)
+        assert expected < 0.95  # the damping was applied
+
+
 def test_stream_analyzer_agrees_with_stream(script, tmp_path):
     """The push-style analyzer and ``fruitimpact stream`` (text samples on stdin) report the same impacts."""
-    recording, _ = fi.synthesize(fi.SensorModel(seed=5, rate=20_000.0, noise=0.01),
-                                 fi.Population(count=3, seed=6, **SYNTH_LOT))
+    recording, truth = fi.synthesize(fi.SensorModel(seed=5, rate=20_000.0, noise=0.01),
+                                     fi.Population(count=3, seed=6, **SYNTH_LOT))
     samples = np.asarray(recording.lanes["lane0"])
     text = "".join(f"{float(v)!r}\n" for v in samples)
     done = script("stream", "--rate", "20000", input=text)
@@ -258,6 +306,11 @@ def test_stream_analyzer_agrees_with_stream(script, tmp_path):
     analyzer.close()
     assert len(lines) == len(analyzer.results) >= 3
     assert [r["peak_force"] for r in lines] == pytest.approx([r["peak_force"] for r in analyzer.results], rel=1e-9)
+    # and against the truth of the contacts (fruit and rebounds): the noise is 1 % of the median peak, so the
+    # largest sample sits within about 3 % of the true peak; the rebound flags are the truth's
+    assert len(lines) == len(truth["impacts"])
+    assert [r["peak_force"] for r in lines] == pytest.approx([i["peak_force"] for i in truth["impacts"]], rel=0.03)
+    assert [r["rebound"] for r in lines] == [i["rebound"] for i in truth["impacts"]]
 
 
 def test_paper_report_agrees_with_the_cli(cli):

@@ -76,7 +76,8 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "rows": "-n/--rows", "seed": "--seed", "chunk_size": "--chunk-size", "workers": "--workers",
                      "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
                      "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
-                     "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size"}
+                     "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size",
+                     "rate": "--rate"}
 
 
 def check_outputs(*outputs) -> None:

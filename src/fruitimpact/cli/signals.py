@@ -8,8 +8,8 @@ import math
 import sys
 
 from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json
+from fruitimpact.impact.validation import conflict_message
 from fruitimpact.impact.outputs import FIGURE_FORMATS
-from fruitimpact.impact.units import parse_quantity
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
@@ -23,10 +23,7 @@ def _rate(text):
     """``--rate`` [Hz]: ``signals.settings.check_rate``, the one check of a sample rate (None when not given)."""
     from fruitimpact.signals.settings import check_rate
 
-    try:
-        return check_rate(text)
-    except ValueError as exc:
-        raise UsageError(f"argument --rate: {exc}") from None
+    return _library_call(check_rate, text)
 
 
 def _json_line(obj) -> str:
@@ -280,16 +277,17 @@ def _classes_option(text: str):
     return tuple(pairs)
 
 
+#: ``synth``'s drop height and restitution when neither they nor their alternatives (--velocity, --alpha) are given.
+SYNTH_DROP_HEIGHT, SYNTH_RESTITUTION = "5cm", "0.577"
+
+
 def cmd_synth(args) -> int:
-    from fruitimpact.impact.outputs import check_output
     from fruitimpact.signals import read as reading
+    from fruitimpact.signals.options import parse_clip
     from fruitimpact.signals.synth import Population, SensorModel, synthesize, truth_path, write_recording, write_truth
 
-    try:
-        fmt = reading.recording_format(args.output, args.format, "--format")
-        check_output(args.output, "-o/--output", None if args.format else dict(reading.EXTENSIONS))
-    except (ValueError, TypeError) as exc:
-        raise UsageError(str(exc)) from None
+    fmt = _library_call(reading.recording_format, args.output, args.format, "--format")
+    check_outputs(("-o/--output", args.output, None if args.format else dict(reading.EXTENSIONS)))
     count = args.count
     if not (str(count).isdigit() and 1 <= int(count) <= 100_000):
         raise UsageError(f"argument --count: must be an integer in [1, 100000]; got {count!r}")
@@ -299,17 +297,14 @@ def cmd_synth(args) -> int:
     rebounds = args.rebounds
     if rebounds not in ("0", "1", "2"):
         raise UsageError(f"argument --rebounds: must be 0, 1 or 2; got {rebounds!r}")
-    clip = (None, None)
-    if args.clip:
-        try:
-            clip = tuple(float(parse_quantity(v, "force")) for v in args.clip.split(","))
-            assert len(clip) == 2 and clip[0] < clip[1]
-        except (ValueError, AssertionError):
-            raise UsageError(f"argument --clip: expected LOW,HIGH in N, LOW < HIGH; got {args.clip!r}") from None
-    if args.velocity is not None and args.drop_height is not None:
-        raise UsageError("give either --velocity or --drop-height, not both")
-    if args.restitution is not None and args.alpha is not None:
-        raise UsageError("give either --restitution or --alpha, not both")
+    clip = _library_call(parse_clip, args.clip)
+    for pair in (("velocity", "drop_height"), ("restitution", "alpha")):
+        if all(getattr(args, name) is not None for name in pair):
+            raise UsageError(conflict_message(["--" + name.replace("_", "-") for name in pair]))
+    if args.velocity is None and args.drop_height is None:
+        args.drop_height = SYNTH_DROP_HEIGHT
+    if args.alpha is None and args.restitution is None:
+        args.restitution = SYNTH_RESTITUTION
     sensor_kwargs = dict(
         rate=_rate(args.rate),
         noise=_float("--noise", args.noise, "dimensionless", low_inclusive=True, high=1.0),
@@ -323,7 +318,7 @@ def cmd_synth(args) -> int:
         antialias_cutoff=_float("--antialias", args.antialias, "frequency", low_inclusive=True),
         seed=int(args.seed) if str(args.seed).isdigit() else -1)
     sensor = _library_call(SensorModel, **sensor_kwargs)
-    height = _float("--drop-height", args.drop_height, "length", high=10.0) if args.velocity is None else None
+    height = _float("--drop-height", args.drop_height, "length", high=10.0) if args.drop_height is not None else None
     population = _library_call(
         Population, count=int(count), interval=_float("--interval", args.interval, "time"),
         mass=_float("--mass", args.mass, "mass"), diameter=_float("--diameter", args.diameter, "length"),
@@ -332,7 +327,7 @@ def cmd_synth(args) -> int:
         classes=_classes_option(args.classes), velocity=_float("--velocity", args.velocity, "velocity"),
         drop_height=height,
         restitution=_float("--restitution", args.restitution, "dimensionless", high=1.0)
-        if args.alpha is None else None,
+        if args.restitution is not None else None,
         alpha=_float("--alpha", args.alpha, "alpha", low_inclusive=True) if args.alpha is not None else None,
         modulus_spread=_float("--modulus-spread", args.modulus_spread, "dimensionless", low_inclusive=True),
         mass_spread=_float("--mass-spread", args.mass_spread, "dimensionless", low_inclusive=True),
@@ -372,7 +367,7 @@ def add_synth_parser(sub) -> None:
     fruit.add_argument("--interval", default="0.25", metavar="S", help="time between fruit (default 0.25 s)")
     fruit.add_argument("--jitter", default="0", metavar="S", help="random shift of each fruit (at most interval/2)")
     fruit.add_argument("--lanes", default="1", metavar="K", help="lanes (default 1)")
-    fruit.add_argument("--drop-height", default="5cm", metavar="H", help="drop height (default 5 cm)")
+    fruit.add_argument("--drop-height", metavar="H", help=f"drop height (default {SYNTH_DROP_HEIGHT} without --velocity)")
     fruit.add_argument("--velocity", metavar="V", help="impact velocity instead of the drop height")
     fruit.add_argument("--mass", default="115g", metavar="M")
     fruit.add_argument("--diameter", default="65mm", metavar="D")
@@ -380,7 +375,8 @@ def add_synth_parser(sub) -> None:
     fruit.add_argument("--modulus-spread", default="0.15", metavar="SD", help="lognormal sd of E (default 0.15)")
     fruit.add_argument("--mass-spread", default="0", metavar="SD", help="lognormal sd of the mass (default 0)")
     fruit.add_argument("--poisson", default="0.37", metavar="NU")
-    fruit.add_argument("--restitution", default="0.577", metavar="E", help="restitution at the drop (default 0.577)")
+    fruit.add_argument("--restitution", metavar="E",
+                       help=f"restitution at the drop (default {SYNTH_RESTITUTION} without --alpha)")
     fruit.add_argument("--alpha", metavar="A", help="Hunt–Crossley α instead of the restitution")
     fruit.add_argument("--rebounds", default="1", metavar="K", help="rebounds followed, 0-2 (default 1)")
     fruit.add_argument("--classes", default="soft:2.5MPa,medium:3.5MPa,firm", metavar="LABEL:E_MAX,...",

@@ -39,7 +39,7 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
-from fruitimpact.signals.indices import impact_indices, second_pulse
+from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import PulseSummary, from_indices, judge, refine, shape_table
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import MISFIT_LIMIT, split_contact
@@ -358,9 +358,28 @@ def _status(impact: DetectedImpact) -> tuple[str, str]:
     return "ok", ""
 
 
+#: Indices the fit restates (the measured ones kept as ``raw_<key>``).
+RESTATED_KEYS = ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c", "firmness_c_star",
+                 "impulse")
+
+
+def report_columns(analysis: Analysis) -> tuple[str, ...]:
+    """Every key a report of ``analysis`` may have, in the order a report builds them: the columns of
+    ``analyze``'s table whichever contacts a recording holds (a fit that did not converge on any contact, or a
+    quiet recording, still gives the columns)."""
+    columns = [*INDEX_KEYS, "sequence", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence"]
+    if analysis.fit:
+        columns += [f"raw_{key}" for key in RESTATED_KEYS]
+        for key in FIT_KEYS:
+            columns += [key, f"{key}_stderr"]
+        columns += ["fit_residual", "fit_residual_relative", "fit_converged", "fit_message"]
+    if analysis.classes is not None:
+        columns += ["class", "class_by"]
+    return (*columns, "status", "message")
+
+
 def _merge_fit(report: dict, result: dict) -> None:
-    for key in ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c",
-                "firmness_c_star", "impulse"):
+    for key in RESTATED_KEYS:
         if key in result and result.get("converged") and _finite(result[key]):
             report[f"raw_{key}"] = report.get(key)
             report[key] = result[key]

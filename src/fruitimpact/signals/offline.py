@@ -65,8 +65,7 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     import pandas as pd
 
     from fruitimpact.impact.validation import InputError, check_integer
-    from fruitimpact.signals.analysis import FIT_KEYS, REPORT_KEYS, public
-    from fruitimpact.signals.indices import INDEX_KEYS
+    from fruitimpact.signals.analysis import public, report_columns
     from fruitimpact.signals.options import analysis_settings
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.recording import Recording
@@ -114,9 +113,10 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
                               on_detected=lambda impact, report: rows.append(public(report)), analysis=analysis,
                               lane_names=names, start_time=start)
     feed_all(analyzer, chunks)
-    if not rows:  # a quiet recording: no contact, but the columns a caller selects are there
-        return pd.DataFrame(columns=[*INDEX_KEYS, *REPORT_KEYS, *(FIT_KEYS if analysis.fit else ())])
-    return pd.DataFrame(rows)
+    # the same columns in the same order whatever the contacts (a quiet recording, a fit that never converged)
+    columns = list(report_columns(analysis))
+    columns += [key for key in dict.fromkeys(k for row in rows for k in row) if key not in columns]
+    return pd.DataFrame(rows, columns=columns)
 
 
 def feed_all(analyzer, chunks, on_chunk=None) -> int:

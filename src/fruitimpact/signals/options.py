@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import InputError
+from fruitimpact.impact.validation import InputError, conflict_message
 
 #: The analysis options (Python name → CLI option), with their defaults as the CLI gives them.
 ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "rebound_window": "--rebound-window", "pitch": "--pitch",
@@ -47,6 +47,19 @@ def _setting_error(exc: ValueError) -> InputError:
     return InputError(f"argument {option}: {text}" if option else text)
 
 
+def parse_clip(text) -> tuple:
+    """``--clip LOW,HIGH`` (forces, units allowed; LOW < HIGH) → (low, high) [N]; (None, None) when not given."""
+    if not text:
+        return None, None
+    try:
+        low, high = (float(parse_quantity(v, "force")) for v in str(text).split(","))
+    except ValueError:
+        raise InputError(f"argument --clip: expected LOW,HIGH in N; got {text!r}") from None
+    if not low < high:
+        raise InputError(f"argument --clip: LOW must be below HIGH; got {text!r}")
+    return low, high
+
+
 def analysis_settings(rate: float, rate_known: bool = True, **options):
     """(DetectorSettings, Analysis) from the analysis ``options`` (``ANALYSIS_OPTIONS``; numbers [SI] or
     strings with units), every value checked before any work (those that depend on the sample rate only
@@ -67,26 +80,18 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     # every plain check first: a usage error is answered before the detector and the fit (numba) are imported
     hum = _number("--hum", args.hum, "frequency")
     lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
-    clip = (None, None)
-    if args.clip:
-        try:
-            low, high = (float(parse_quantity(v, "force")) for v in args.clip.split(","))
-        except ValueError:
-            raise InputError(f"argument --clip: expected LOW,HIGH in N; got {args.clip!r}") from None
-        if not low < high:
-            raise InputError(f"argument --clip: LOW must be below HIGH; got {args.clip!r}")
-        clip = (low, high)
+    clip = parse_clip(args.clip)
     velocity = _number("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop
     height = _number("--drop-height", args.drop_height, "length", high=10.0)
     if velocity is not None and height is not None:
-        raise InputError("give either --velocity or --drop-height, not both")
+        raise InputError(conflict_message(["--velocity", "--drop-height"]))
     if height is not None:
         velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
     window = _number("--rebound-window", args.rebound_window, "time", low_inclusive=True, high=10.0)
     pitch = _number("--pitch", args.pitch, "time", low=1e-3, low_inclusive=True, high=60.0)
     fruit_rate = _number("--fruit-rate", args.fruit_rate, "frequency", high=1000.0)
     if pitch is not None and fruit_rate is not None:
-        raise InputError("give either --pitch or --fruit-rate, not both")
+        raise InputError(conflict_message(["--pitch", "--fruit-rate"]))
     if fruit_rate is not None:
         pitch = 1.0 / fruit_rate
     k_on = _number("--k-on", args.k_on, "dimensionless")

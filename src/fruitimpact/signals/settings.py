@@ -4,11 +4,13 @@ each value checked at construction with a one-line ``ValueError`` naming it and 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from fruitimpact.impact.validation import check_number
+from fruitimpact.impact.units import parse_quantity
+from fruitimpact.impact.validation import InputError, check_number
 
 __all__ = ["DetectorSettings"]
 
@@ -114,13 +116,6 @@ MAX_RATE = 10e6
 def check_rate(rate, argument: str = "rate") -> float | None:
     """A sample rate [Hz] (a number or a string with a unit, ``"20kHz"``) as a float in (0, ``MAX_RATE``]; None
     stays None.  ``InputError`` naming ``argument`` otherwise."""
-    import math
-
-    import numpy as np
-
-    from fruitimpact.impact.units import parse_quantity
-    from fruitimpact.impact.validation import InputError
-
     if rate is None:
         return None
     if isinstance(rate, str):

@@ -34,6 +34,14 @@ class FirmnessClasses:
     labels: tuple
 
     def __post_init__(self):
+        for name in ("labels", "thresholds"):  # "ab" is two letters, not two class names
+            if isinstance(getattr(self, name), (str, bytes)) or not hasattr(getattr(self, name), "__iter__"):
+                raise ValueError(f"{name} must be a sequence (labels: class names, softest first); "
+                                 f"got {getattr(self, name)!r}")
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        if len(self.labels) < 2:
+            raise ValueError(f"classes need at least two labels (one threshold between them); got "
+                             f"{list(self.labels)}")
         if self.by not in SORT_INDICES:
             raise ValueError(f"by must be one of {', '.join(SORT_INDICES)}; got {self.by!r}")
         if len(self.labels) != len(self.thresholds) + 1:
@@ -101,6 +109,8 @@ def calibrate(values, labels, classes, by: str) -> FirmnessClasses:
     if isinstance(classes, str):
         raise ValueError(f"classes must be a sequence of class names, softest first (e.g. ('soft', 'firm')); "
                          f"got the string {classes!r}")
+    if len(classes) < 2:
+        raise ValueError(f"classes must name at least two classes, softest first; got {list(classes)}")
     values = np.asarray(values, dtype=float)
     labels = np.asarray(labels, dtype=object)
     classes = tuple(classes)

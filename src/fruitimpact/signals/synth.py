@@ -48,6 +48,7 @@ from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_integer, check_number
 from fruitimpact.signals.read import _column, recording_format
 from fruitimpact.signals.recording import Recording
+from fruitimpact.signals.settings import check_rate
 
 #: Number of output samples simulated at once on the analogue grid (bounds the memory of long recordings).
 _CHUNK = 1 << 16
@@ -98,12 +99,12 @@ class SensorModel:
     Parameters
     ----------
     rate : float
-        Sample rate [Hz] (default 20 kHz).
+        Sample rate [Hz] in (0, 10 MHz] (default 20 kHz; ``signals.settings.check_rate``).
     noise_sd : float
         Standard deviation of the white noise [N] (default 0: none).
     noise : float
         The white noise instead as a fraction of the typical peak force: the
-        median ``peak_force`` of the given (not rebound) impacts.  At most one
+        median ``peak_force`` of the given (not rebound) impacts, in [0, 1].  At most one
         of ``noise_sd`` and ``noise`` may be non-zero.
     drift : float
         Linear baseline drift [N/s], from t = 0 (default 0).
@@ -153,11 +154,11 @@ class SensorModel:
 
     def __post_init__(self):
         o = "SensorModel"
-        rate = _number(o, "rate", self.rate, low=0.0, low_inclusive=False)
+        rate = check_rate(self.rate, "rate")  # the one check of a sample rate (signals.settings)
         values = {
             "rate": rate,
             "noise_sd": _number(o, "noise_sd", self.noise_sd, low=0.0),
-            "noise": _number(o, "noise", self.noise, low=0.0),
+            "noise": _number(o, "noise", self.noise, low=0.0, high=1.0, high_inclusive=True),
             "drift": _number(o, "drift", self.drift),
             "drift_offset": _number(o, "drift_offset", self.drift_offset),
             "hum_amplitude": _number(o, "hum_amplitude", self.hum_amplitude, low=0.0),

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from fruitimpact.impact.validation import InputError
+from fruitimpact.signals.settings import check_rate  # noqa: F401  (the one check of a rate, re-exported)
 
 #: Formats and their extensions (the first extension is the one written by default).
 FORMATS = {"csv": (".csv", ".txt"), "npy": (".npy",), "f32": (".f32", ".bin", ".raw"), "tdms": (".tdms",)}
@@ -86,13 +87,6 @@ def read_exactly(handle, path, position: int, size: int) -> bytes:
         raise error(path, f"the file ends at byte {position + len(data)}, before byte {position + size} its "
                           f"header promises (truncated, or changed since it was opened)")
     return data
-
-
-def check_rate(rate) -> float | None:
-    """``rate`` [Hz] as a float (None stays None): ``signals.settings.check_rate``, the one check of a rate."""
-    from fruitimpact.signals.settings import check_rate as check
-
-    return check(rate)
 
 
 def need_rate(path, rate, why: str) -> float:
