@@ -80,6 +80,42 @@ def test_safe_height_ordered_by_surface():
     assert heights["wood"] / heights["steel"] - 1 < 0.05  # wood across the grain: ~1 % softer contact
 
 
+def test_a_failed_evaluation_inside_the_bracket_is_not_taken_for_no_bruise(monkeypatch):
+    """An impact that fails (status failed, no margin) between 2 and 5 cm: its NaN margin is neither side of the
+    root.  The search used to keep narrowing on it and answer 5 cm with "ok" (the root is 3.3 cm); it must say it
+    failed, and where."""
+    from fruitimpact.handling import heights
+
+    honest = safe_height(fruit="apple", criterion="shear", sensitivity=False)
+    assert 0.02 < honest["safe_height"] < 0.05 and honest["status"] == "ok"
+    real = heights._margins
+
+    def failing_between_2_and_5_cm(table, drops):
+        margins, result = real(table, drops)
+        inside = (np.asarray(drops) > 0.02) & (np.asarray(drops) < 0.05)
+        result.status[inside] = 2  # failed
+        result.messages.set(inside, "the solver did not reach separation (injected)")
+        return np.where(inside, np.nan, margins), result
+
+    monkeypatch.setattr(heights, "_margins", failing_between_2_and_5_cm)
+    report = safe_height(fruit="apple", criterion="shear", sensitivity=False)
+    assert math.isnan(report["safe_height"]) and report["status"] == "failed"
+    assert "the search failed at h = " in report["message"] and "(injected)" in report["message"]
+
+
+def test_a_firmness_map_follows_hertz_scaling():
+    """On a rigid plane at a fixed restitution the peak pressure is Hertzian, p0 ∝ (E*⁴ m V²/R³)^(1/5) (the
+    damping shapes the pulse, x = c V is fixed by e), and so is the shear stress (τ_max/p0 depends on ν only): the
+    safe height h ∝ V² ∝ p_f⁵/E*⁴ falls as E⁻⁴ across the map.  Tolerance: the root search's 1e-9 on ln h."""
+    from fruitimpact.handling.heights import risk_map
+
+    risk = risk_map(by="firmness", fruit="apple", criterion="shear")
+    moduli = [float(c) for c in risk["columns"]]
+    heights = [risk["safe_height"][str(c)] for c in risk["columns"]]
+    expected = [heights[0] * (moduli[0] / e) ** 4 for e in moduli]
+    assert heights == pytest.approx(expected, rel=1e-7)
+
+
 def test_safe_height_edges_are_said():
     never = safe_height(criterion="energy", bruise_energy=100.0, sensitivity=False)
     assert never["safe_height"] == math.inf and "no bruise up to" in never["message"]
@@ -112,10 +148,14 @@ def test_drop_energy_is_conserved_and_plastic_work_only_on_the_first_impact():
 
 
 def test_drop_refuses_a_free_partner_and_a_velocity():
-    with pytest.raises(ValueError, match="surface fruit is a free partner"):
-        drop(0.1, surface="fruit")
+    for partner in ({"surface": "fruit"}, {"surface": " fruit "}, {"partner_mass": 0.1}):  # as resolved
+        with pytest.raises(ValueError, match="a drop bounces on a fixed surface, not a free partner"):
+            drop(0.1, **partner)
     with pytest.raises(ValueError, match="velocity is set by the drop"):
         drop(0.1, velocity=2.0)
+    with pytest.raises(ValueError, match="drop_height must be given"):
+        drop(None)  # was an "ok" drop at the default 1 m/s with a NaN height
+    assert drop(0.1, velocity=None)["status"] == "ok"  # None is "not given", as everywhere
 
 
 def test_line_incidence_is_the_batch_bruise_rate_of_the_same_members(tmp_path):
@@ -452,6 +492,38 @@ def test_line_changes_are_the_audit_of_the_changed_line():
     assert change["incidence"] == pytest.approx(changed["incidence"], abs=1e-12)
     assert change["incidence_saved"] == pytest.approx(report["incidence"] - changed["incidence"], abs=1e-12)
     assert change["mean_bruise_volume"] == pytest.approx(changed["mean_bruise_volume"], rel=1e-12)
+
+
+def test_a_point_where_no_fruit_was_computed_is_unknown_not_harmless(monkeypatch, cli, tmp_path):
+    """Every fruit failing at one transfer point: that point's incidence is unknown (NaN), not 0 %, it cannot be
+    the most harmful point by default, the line as a whole is failed (no fruit went through it), and the command
+    says so and exits 1."""
+    from fruitimpact.impact import evaluation as module
+
+    real = module.evaluation
+
+    def failing_on_steel(table, **kwargs):
+        result = real(table, **kwargs)
+        if table.get("surface") == "steel":
+            result.status[:] = 2
+            result.messages.set(np.ones(result.rows, dtype=bool), "the solver did not reach separation (injected)")
+        return result
+
+    monkeypatch.setattr(module, "evaluation", failing_on_steel)
+    rng = np.random.default_rng(5)
+    rows = 50
+    members = {"mass": rng.normal(0.18, 0.02, rows), "failure_stress": np.full(rows, 3e5)}
+    points = [TransferPoint("tipper", 0.1, "steel"), TransferPoint("belt", 0.04, "pvc-belt")]
+    report = audit(points, members, rows, "shear", {}, ())
+    tipper, belt = report["points"]
+    assert math.isnan(tipper["incidence"]) and math.isnan(tipper["mean_bruise_volume"])
+    assert math.isfinite(belt["incidence"]) and report["worst_point"] == "belt"
+    assert math.isnan(report["incidence"]) and report["fruit_computed"] == 0
+    assert report["status"] == "failed" and "no fruit of the 50" in report["message"]
+    line = tmp_path / "line.csv"
+    line.write_text("name,drop_height,surface\ntipper,10cm,steel\nbelt,4cm,pvc-belt\n")
+    status, out, _ = cli.run("line", line, "-n", "50", "--fruit", "apple", "--criterion", "shear")
+    assert status == 1 and "FAILED: no fruit" in out
 
 
 # ---------------------------------------------------------------- issue 14 item 3: corrugated board crushes

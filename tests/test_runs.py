@@ -328,7 +328,8 @@ def test_work_directory_of_another_job_is_refused(tmp_path, cli, monkeypatch):
     (["--characteristics", "peak_force,nope"], "argument --characteristics: unknown characteristic 'nope'"),
     (["--percentiles", "50,101"], "argument --percentiles"),
     (["-n", "0"], "argument -n/--rows: rows must be an integer in [1, 1,000,000,000]"),
-    (["--seed", "-3"], "argument --seed: seed must be an integer >= 0"),
+    (["--seed", "-3"], "argument --seed: seed must be an integer in [0, 340,282,366,920,938,463,463,374,607,431,768,211,455]"),
+    (["--seed", "1e9999999"], "argument --seed: seed must be an integer in [0, "),
     (["--model", "nope"], "argument --model: model must be one of"),
     (["--chunk-size", "1.5"], "argument --chunk-size: chunk_size must be an integer in [1, 10,000,000]"),
 ])

@@ -30,15 +30,7 @@ def cmd_drop(args) -> int:
 
     kwargs = _without_velocity(args)
     height = kwargs.pop("drop_height", None)
-    if height is None:
-        raise UsageError("argument --drop-height: required (the height the fruit falls from, e.g. 10cm)")
-    try:
-        max_impacts = int(args.max_impacts)
-    except ValueError:
-        max_impacts = -1
-    if not 1 <= max_impacts <= 1000:
-        raise UsageError(f"argument --max-impacts: must be an integer in [1, 1000]; got {args.max_impacts!r}")
-    report = _library_call(drop, height, max_impacts=max_impacts, bounces=args.bounces, **kwargs)
+    report = _library_call(drop, height, max_impacts=args.max_impacts, bounces=args.bounces, **kwargs)
     _print_warnings("drop", report["warnings"])
     if args.json:
         print(dump_json(report))
@@ -75,16 +67,21 @@ def cmd_safe_height(args) -> int:
     check_outputs(("--map-csv", args.map_csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
     if (args.map_csv or args.plot) and not args.map:
         args.map = "surface"
-    report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
-    if args.map:
+    risk = None
+    if args.map:  # first: its arguments are answered before either search runs
         from fruitimpact.handling.heights import MAP_AXES, risk_map
 
-        # the map spans every value of its axis; the value given is the safe height's, above
+        # the map spans every value of its axis; the value given is the safe height's, below
         risk = _library_call(risk_map, by=args.map, **{k: v for k, v in kwargs.items() if k != MAP_AXES[args.map]})
+    report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
+    if risk is not None:
         key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows",
                                                                      "safe_height"))
         report["risk_map"] = {"by": key, "safe_height": safe}
-        report["warnings"] += [text for text in risk["warnings"] if text not in report["warnings"]]
+        # the map's warnings say on how many grid points: one the safe height already gave is not said twice
+        given = report["warnings"]
+        report["warnings"] += [text for text in risk["warnings"]
+                               if not any(text == known or text.startswith(known + " (") for known in given)]
         if args.map_csv:
             from fruitimpact.impact.outputs import atomic_write
 
@@ -105,7 +102,6 @@ def cmd_safe_height(args) -> int:
                           args.plot, "--plot")
     _print_warnings("safe-height", report["warnings"])
     height = report["safe_height"]
-    report["status"] = "ok" if not math.isnan(height) else "failed"
     if args.json:
         print(dump_json(report))
     else:
@@ -171,7 +167,9 @@ def cmd_line(args) -> int:
                   f"{change['bruise_volume_saved'] * 1e9:.4g})")
         if args.plot:
             print(f"figure written to {args.plot}")
-    return 0
+        if report["status"] != "ok":
+            print(f"{report['status'].upper()}: {report['message']}")
+    return 0 if report["status"] == "ok" else 1
 
 
 # ------------------------------------------------------------------------------------------ libraries
@@ -209,14 +207,18 @@ def cmd_surfaces(args) -> int:
 
 
 def add_parsers(sub) -> None:
+    from fruitimpact.handling.drops import BOUNCE_RULES, MAX_IMPACTS
+    from fruitimpact.handling.heights import AXIS_INPUTS
+    from fruitimpact.handling.line import LINE_FRUIT
     from fruitimpact.impact.quantities import INPUTS as TABLE
 
     dr = sub.add_parser("drop", help="drop a fruit from a height: the rebounds until it rests, damage per impact",
                         description="Drop a fruit from --drop-height onto a surface; every impact at its own "
                                     "velocity, its restitution from the model.")
     _add_impact_options(dr)
-    dr.add_argument("--max-impacts", default="50", metavar="N", help="impacts followed at most (default 50)")
-    dr.add_argument("--bounces", default="material", choices=("material", "constant"),
+    dr.add_argument("--max-impacts", default=str(MAX_IMPACTS), metavar="N",
+                    help=f"impacts followed at most (default {MAX_IMPACTS})")
+    dr.add_argument("--bounces", default="material", choices=tuple(BOUNCE_RULES),
                     help="restitution of the later impacts: material (default: the damping calibrated at the "
                          "first impact is kept, e rises as the fruit slows, as drop tests show) or constant "
                          "(every impact at the same e)")
@@ -241,11 +243,13 @@ def add_parsers(sub) -> None:
     ln.add_argument("line", metavar="LINE", help="the line's transfer points, CSV")
     group = ln.add_argument_group("population (numbers, or normal(m,sd), lognormal(m,cv), uniform(a,b), ...)")
     for quantity in TABLE.values():
-        if quantity.option and quantity.name not in ("velocity", "drop_height", "surface"):
+        # each transfer point sets its height and its surface: those inputs are not options of a line
+        if quantity.option and quantity.name not in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):
             group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
                                help=quantity.doc)
-    group.add_argument("-n", "--rows", default="10000", metavar="N", help="fruit in the population (default 10000)")
-    group.add_argument("--seed", default="0", metavar="S", help="random seed (default 0)")
+    group.add_argument("-n", "--rows", default=str(LINE_FRUIT), metavar="N",
+                       help=f"fruit in the population (default {LINE_FRUIT})")
+    group.add_argument("--seed", default="0", metavar="S", help="random seed, an integer from 0 to 2^128 - 1 (default 0)")
     add_spread_option(group)
     ln.add_argument("--alternatives", default="foam-pad", metavar="SURFACES",
                     help="library surfaces tried in place of each transfer point's, to say what each change would "

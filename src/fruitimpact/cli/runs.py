@@ -231,7 +231,7 @@ def add_parsers(sub) -> None:
             group.add_argument(option, dest=dest, metavar="NAME", help=f"{dest} (one name)")
     group.add_argument("-n", "--rows", default="10000", metavar="N",
                        help=f"members, 1 to {MAX_ROWS:,} (default 10000; 1e7 allowed)")
-    group.add_argument("--seed", default="0", metavar="S", help="random seed, integer >= 0, exact (default 0)")
+    group.add_argument("--seed", default="0", metavar="S", help="random seed, an integer from 0 to 2^128 - 1, exact (default 0)")
     add_spread_option(group)
     stats = pop.add_argument_group("summary")
     stats.add_argument("--characteristics", metavar="LIST",

@@ -2,7 +2,7 @@
 
 * ``drops``: one drop with all its bounces (:func:`drop`);
 * ``heights``: the safe drop height onto a surface (:func:`safe_height`);
-* ``line``: the bruise audit of a line of transfer points over a lot (:func:`audit`).
+* ``line``: the bruise audit of a line of transfer points over a lot (:func:`audit_line`).
 
 The bruise criteria themselves are in :mod:`fruitimpact.damage`; the impacts come from
 :mod:`fruitimpact.impact.evaluation`.

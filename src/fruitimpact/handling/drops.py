@@ -106,10 +106,13 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     64 (1997) 383–386; bounce rule: docs/damage.md.
     """
     from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.validation import InputError, check_integer, check_number
+    from fruitimpact.impact.validation import InputError, check_number, read_count
 
+    if drop_height is None:
+        raise InputError("drop_height must be given: the height the fruit falls from [m], e.g. 0.3 or \"30cm\"",
+                         "drop_height")
     for name in ("velocity", "drop_height"):
-        if name in inputs:
+        if inputs.get(name) is not None:
             raise InputError(f"{name} is set by the drop: give drop_height as the first argument", name)
     unknown = [name for name in inputs if name not in INPUTS]
     if unknown:
@@ -121,10 +124,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
                          "alpha or damping the law sets e at each speed, which is bounces material)", "bounces")
     rest_height = check_number("rest_height", rest_height, low=0.0, low_inclusive=False, high=1.0,
                                high_inclusive=True)
-    max_impacts = check_integer("max_impacts", max_impacts, 1, 1000)
-    if inputs.get("surface") == "fruit":
-        raise InputError("surface fruit is a free partner: a drop bounces on a fixed surface (simulate the "
-                         "fruit-on-fruit impact itself with --surface fruit)", "surface")
+    max_impacts = read_count("max_impacts", max_impacts, 1, 1000)
     # the engine only now: every argument above is answered without it
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
@@ -135,16 +135,18 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     first = evaluate_inputs(read, messages, detail=True)
     if first.status[0] == 3:  # invalid: the one-line refusal, naming the argument
         raise InputError(messages.text(0), messages.argument(0))
+    if math.isfinite(first.columns["partner_mass"][0]):  # as resolved: surface "fruit" (any spelling), partner_mass
+        raise InputError("a drop bounces on a fixed surface, not a free partner (surface fruit, partner_mass): "
+                         "simulate the fruit-on-fruit impact itself with --surface fruit", "surface")
     height = float(first.columns["drop_height"][0])
     criterion = first.columns["criterion"][0]
     impacts = []
     warnings = list(first.warnings.row(0))
     status, message = "ok", "ok"
-    velocity = math.sqrt(2.0 * STANDARD_GRAVITY * height)
     time = math.sqrt(2.0 * height / STANDARD_GRAVITY)
     result = first
     flattened = None
-    material_factor = float(first.columns["damping_factor"][0]) if "damping_factor" in first.columns else 0.0
+    material_factor = float(first.columns["damping_factor"][0])
     if not math.isfinite(material_factor):
         material_factor = 0.0
     while True:

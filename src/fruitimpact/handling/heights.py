@@ -7,7 +7,7 @@ variant of regula falsi (bracketed, superlinear) on all rows of a table at
 once: every iteration is one ``impact.evaluation.evaluate`` of the table.  It is a root,
 not a scan: to a relative tolerance of 1e-9 in h.
 
-Checked (tests/test_heights.py) against the closed form of elastic Hertz on a
+Checked (tests/test_damage.py) against the closed form of elastic Hertz on a
 rigid flat, h = π⁴ p⁵ / (80 g ρ E*⁴) (p = σ_f for the pressure criterion,
 p = σ_f p_0/Y(ν) for the shear criterion): independent of the fruit's size,
 with d ln h/d ln E = −4 and d ln h/d ln σ_f = 5.
@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from fruitimpact.impact.status import STATUS_NAMES
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 #: The heights searched [m]: below the lowest the fruit bruises "from any height", above the highest never.
@@ -72,7 +73,16 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
         x = np.where(active, high - f_high * (high - low) / (f_high - f_low), 0.5 * (low + high))
         bad = ~((x > low) & (x < high))
         x[bad] = 0.5 * (low[bad] + high[bad])
-        f_x, _ = _margins(table, np.exp(x))
+        f_x, step = _margins(table, np.exp(x))
+        # a row whose evaluation inside the bracket failed has no margin there: it is not a root, and its NaN
+        # must not count as "no bruise" (that narrowed the bracket onto a wrong height reported as ok)
+        lost = active & ((step.status != 0) | np.isnan(f_x))
+        for i in np.flatnonzero(lost):
+            text = step.messages.text(i)
+            messages[i] = (f"the search failed at h = {math.exp(x[i]):.4g} m: "
+                           f"{text if text and text != 'ok' else 'no bruise margin there'}")
+            low[i] = high[i] = math.nan
+        active &= ~lost
         above = f_x >= 0.0
         # Illinois: halve the retained end's value when the same end is kept twice
         keep_low = active & above
@@ -159,6 +169,9 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     Onset of bruising under the Hertz contact: K. L. Johnson, *Contact Mechanics* (1985) eq 3.45 and §11.4;
     the shear criterion after Yuwana & Duprat (1998); docs/bruise.md.
     """
+    from fruitimpact.impact.validation import check_flag
+
+    sensitivity = check_flag("sensitivity", sensitivity)
     given, base = _checked_inputs(inputs, "safe-height finds")
     criterion = given["criterion"]
     names = SENSITIVITY_INPUTS.get(criterion, ())
@@ -172,7 +185,8 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
     heights, messages = safe_heights(table, len(cases))
     height = float(heights[0])
     report = {"safe_height": height, "safe_velocity": math.sqrt(2.0 * STANDARD_GRAVITY * height)
-              if math.isfinite(height) else height, "criterion": criterion, "message": messages[0],
+              if math.isfinite(height) else height, "criterion": criterion,
+              "status": "failed" if math.isnan(height) else "ok", "message": messages[0],
               "warnings": base.warnings.row(0)}
     if sensitivity:
         report["sensitivity"] = {}
@@ -186,6 +200,9 @@ def safe_height(*, sensitivity: bool = True, **inputs) -> dict:
 
         at = evaluation({name: [value] for name, value in {**given, "drop_height": height}.items()})
         report["warnings"] += [text for text in at.warnings.row(0) if text not in report["warnings"]]
+        if at.status[0] != 0:  # the height stands (its bracket was computed); the figures at it do not
+            report["warnings"].append(f"the impact at the safe height is {STATUS_NAMES[int(at.status[0])]}: "
+                                      f"{at.messages.text(0)}")
         for name in ("peak_force", "max_pressure", "max_shear_stress", "fruit_energy", "absorbed_energy",
                      "restitution", "failure_stress", "bruise_energy"):
             report[name] = float(at.columns[name][0])
@@ -255,8 +272,6 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     ----------
     As :func:`safe_height`.
     """
-    import numpy as np
-
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.registries import SURFACE_CHOICES
     from fruitimpact.impact.validation import InputError

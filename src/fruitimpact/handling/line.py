@@ -189,7 +189,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         bruised_any |= bruised
         volume_total += volume
         valid_so_far &= ok
-        count = max(int(ok.sum()), 1)
+        count = int(ok.sum())  # no fruit computed at a point: its figures are unknown (NaN), never 0
         for bit, text in enumerate(result.warnings.texts):  # the inputs' and the impacts' own warnings
             carrying = int(np.count_nonzero(result.warnings.masks >> bit & 1))
             noted.setdefault(text, []).append((point.name, carrying))
@@ -198,27 +198,29 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             warnings.append(f"transfer point {point.name!r}: {int((~ok).sum())} of {rows} fruit not computed "
                             f"(invalid or failed; the first: {result.messages.text(first)}); the figures are of the "
                             f"others")
-        kept = max(int(valid_so_far.sum()), 1)
+        kept = int(valid_so_far.sum())
         report.append({
             "name": point.name, "drop_height": point.drop_height, "surface": point.surface,
             "fruit_on_fruit": point.fruit_on_fruit,
             "velocity": math.sqrt(2.0 * STANDARD_GRAVITY * point.drop_height),
-            "incidence": float(bruised[ok].sum() / count),
-            "mean_bruise_volume": float(volume[ok].sum() / count),
+            "incidence": _share(bruised[ok].sum(), count),
+            "mean_bruise_volume": _share(volume[ok].sum(), count),
             "mean_peak_force": float(np.mean(result.columns["peak_force"][ok])) if ok.any() else math.nan,
             "mean_max_pressure": float(np.mean(result.columns["max_pressure"][ok])) if ok.any() else math.nan,
-            "cumulative_incidence": float(bruised_any[valid_so_far].sum() / kept),
-            "cumulative_bruise_volume": float(volume_total[valid_so_far].sum() / kept),
+            "cumulative_incidence": _share(bruised_any[valid_so_far].sum(), kept),
+            "cumulative_bruise_volume": _share(volume_total[valid_so_far].sum(), kept),
             "invalid": int((status == 3).sum()), "failed": int((status == 2).sum()),
         })
     for text, where in noted.items():  # each warning once, with where and for how many fruit
         places = ", ".join(f"{name!r} ({count} of {rows})" for name, count in where)
         warnings.append(f"{text} (at {places})" if len(where) < len(points) else
                         f"{text} (at every transfer point, {max(c for _, c in where)} of {rows} fruit at most)")
-    worst = max(range(len(report)), key=lambda i: (report[i]["incidence"], report[i]["mean_bruise_volume"]))
-    kept = max(int(valid_so_far.sum()), 1)
-    incidence = float(bruised_any[valid_so_far].sum() / kept)
-    mean_volume = float(volume_total[valid_so_far].sum() / kept)
+    known = [i for i in range(len(report)) if not math.isnan(report[i]["incidence"])]
+    worst = max(known, key=lambda i: (report[i]["incidence"], _or_zero(report[i]["mean_bruise_volume"]))) \
+        if known else None
+    kept = int(valid_so_far.sum())
+    incidence = _share(bruised_any[valid_so_far].sum(), kept)
+    mean_volume = _share(volume_total[valid_so_far].sum(), kept)
     changes = []
     for k, point in enumerate(points):
         if point.fruit_on_fruit:
@@ -246,19 +248,36 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
                             "incidence_saved": base - changed, "mean_bruise_volume": changed_volume,
                             "bruise_volume_saved": base_volume - changed_volume, "fruit": int(ok.sum())})
     changes.sort(key=lambda c: (-c["incidence_saved"], -c["bruise_volume_saved"]))
-    return {"criterion": criterion, "fruit": rows, "fruit_computed": int(valid_so_far.sum()), "points": report,
-            "worst_point": report[worst]["name"], "incidence": incidence, "mean_bruise_volume": mean_volume,
-            "changes": changes, "warnings": warnings}
+    status, message = "ok", ""
+    if kept == 0:  # no fruit went through the whole line: there is no line figure to report
+        status = "failed"
+        message = (f"no fruit of the {rows} was computed at every transfer point (each was invalid or failed at one "
+                   f"of them; see the warnings): the line's incidence and bruise volume are unknown")
+    return {"criterion": criterion, "fruit": rows, "fruit_computed": kept, "status": status, "message": message,
+            "points": report, "worst_point": report[worst]["name"] if worst is not None else None,
+            "incidence": incidence, "mean_bruise_volume": mean_volume, "changes": changes, "warnings": warnings}
 
 
-__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "MAX_POINTS", "TransferPoint", "audit", "read_line"]
+def _share(total, count: int) -> float:
+    """``total / count``, or NaN (unknown) when no fruit was counted."""
+    return float(total / count) if count else math.nan
+
+
+def _or_zero(value: float) -> float:
+    return 0.0 if math.isnan(value) else value
+
+
+__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS", "TransferPoint", "audit",
+           "audit_line", "read_line"]
 
 
 #: Most fruit of one line audit.
 MAX_LINE_FRUIT = 10_000_000
+#: Fruit in a line audit's lot by default (the command's and the function's).
+LINE_FRUIT = 10_000
 
 
-def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None = None,
+def audit_line(line, *, rows: int = LINE_FRUIT, seed: int = 0, criterion: str | None = None,
                alternatives=DEFAULT_ALTERNATIVES, spreads: bool = True, **inputs) -> dict:
     """Audit a handling line: pass a lot of ``rows`` fruit through its transfer points and count the bruises.
 
@@ -273,7 +292,7 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
     line : str, path or list of TransferPoint
         A line CSV (``name,drop_height,surface[,fruit_on_fruit]``, see :func:`read_line`) or its points.
     rows : int
-        Fruit in the lot, 1 to 10,000,000.
+        Fruit in the lot, 1 to 10,000,000 (default 10,000; ``"1e5"`` accepted).
     seed : int
         Seed of the lot's draws (≥ 0): the same seed gives the same fruit.
     criterion : str, optional
@@ -313,14 +332,15 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
     """
     from fruitimpact.handling.heights import AXIS_INPUTS
     from fruitimpact.impact.distributions import parse_distribution
-    from fruitimpact.impact.lots import PopulationSource
+    from fruitimpact.impact.lots import MAX_SEED, PopulationSource
     from fruitimpact.impact.presets import fruit_criterion, lot_distributions
     from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.registries import REGISTRIES
-    from fruitimpact.impact.validation import InputError, check_choice, read_count
+    from fruitimpact.impact.validation import InputError, check_choice, check_flag, read_count
 
+    spreads = check_flag("spreads", spreads)
     rows = read_count("rows", rows, 1, MAX_LINE_FRUIT)
-    seed = read_count("seed", seed, 0)
+    seed = read_count("seed", seed, 0, MAX_SEED)
     points = _points(line)
     if criterion == "none":
         raise InputError("criterion must be given for a line audit: pressure, shear or energy (the onset height "
@@ -351,7 +371,6 @@ def audit_line(line, *, rows: int = 1000, seed: int = 0, criterion: str | None =
                                                   spreads=spreads)
     drawn = distributions + list(extra)
     members, _ = PopulationSource(tuple(drawn), (), rows, seed, density).inputs(0, rows, None)
-    members.pop("model", None)
     report = audit(points, members, rows, criterion, constants, tuple(alternatives))
     report.update(rows=rows, seed=seed, inputs={name: dist.describe() for name, dist in drawn},
                   spreads=list(described))

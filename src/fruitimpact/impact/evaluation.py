@@ -58,9 +58,6 @@ BRUISE_INPUTS = ("failure_stress", "bruise_susceptibility", "bruise_energy", "br
 #: replaces the sphere in Hertz's solution is then more than (a/R)²/4 = 4 % off at the contact edge.
 HERTZ_RANGE = 0.4
 
-# compatibility names of earlier versions: numeric input columns (dimension, default) and text columns
-INPUT_COLUMNS = {name: (INPUTS[name].dimension, INPUTS[name].default) for name in NUMERIC_INPUTS}
-TEXT_COLUMNS = {name: INPUTS[name].default for name in TEXT_INPUTS}
 
 
 @dataclass
@@ -750,5 +747,5 @@ def curves(table, times=None, points: int = 201):
     return dict(row=rows, time=grid, deflection=deflection, rate=rate, force=force)
 
 
-__all__ = ["Evaluation", "HERTZ_RANGE", "INPUT_COLUMNS", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES", "TEXT_COLUMNS",
+__all__ = ["Evaluation", "HERTZ_RANGE", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES",
            "curves", "evaluate", "evaluate_inputs", "evaluation"]

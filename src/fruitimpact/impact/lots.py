@@ -16,6 +16,9 @@ import numpy as np
 from fruitimpact.impact.labels import Labels
 from fruitimpact.impact.quantities import INPUTS
 
+#: Largest seed of a lot: numpy's SeedSequence takes any integer, but 128 bits is all the entropy it keeps in
+#: its pool, and a bound answers "1e9999999" at once instead of building a ten-million-digit integer.
+MAX_SEED = 2 ** 128 - 1
 #: Rows per random block of a lot (a member's draws depend on its row, not on how the rows are cut).
 BLOCK_ROWS = 65_536
 

@@ -247,8 +247,6 @@ def effective_mass(mass, partner_mass):
         return np.where(np.isinf(partner_mass), mass, mass * partner_mass / (mass + partner_mass))
 
 
-__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
-           "lot_spreads", "resolve"]
 assert all(name in INPUTS for name in DAMAGE_DEFAULTS)
 
 
@@ -267,3 +265,7 @@ def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: 
     except ValueError as exc:
         raise InputError(str(exc), "fruit") from None
     return lot.distributions, lot.diameter_density, lot.described
+
+
+__all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "lot_distributions", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
+           "lot_spreads", "resolve"]

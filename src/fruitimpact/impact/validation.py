@@ -132,6 +132,18 @@ def check_integer(name: str, value, low: int, high: int | None = None, *, owner:
     return int(value)
 
 
+def check_flag(name: str, value) -> bool:
+    """``value`` if it is True or False (a numpy bool too), else ``InputError`` naming ``name``: a text such as
+    ``"no"`` is truthy and would do the opposite of what was meant."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name} must be True or False; got {value!r}", name)
+    return bool(value)
+
+
+#: Most digits of a count read from text (Python's own limit for converting text to int is 4300).
+_MAX_DIGITS = 4000
+
+
 def read_count(name: str, value, low: int, high: int | None = None) -> int:
     """An exact integer in [low, high] from an int or a text such as ``"10000000"`` or ``"1e7"`` (read as a
     decimal, never through a float, so that a seed above 2^53 keeps every digit); ``InputError`` naming
@@ -147,8 +159,9 @@ def read_count(name: str, value, low: int, high: int | None = None) -> int:
             number = decimal.Decimal(value.strip())
         except decimal.InvalidOperation:
             number = None
-    if number is None or not number.is_finite() or number != number.to_integral_value() or number < low \
-            or (high is not None and number > high):
+    # a bound before any int(): "1e9999999" would otherwise become a ten-million-digit integer
+    if number is None or not number.is_finite() or number.adjusted() > _MAX_DIGITS or number < low \
+            or (high is not None and number > high) or number != number.to_integral_value():
         raise InputError(f"{name} must be an integer {allowed}; got {value!r}", name)
     return int(number)
 
@@ -244,6 +257,6 @@ def implausible_message(quantity: Quantity, value: float | None = None) -> str:
             f"[{plausible.low:g}, {plausible.high:g}]{unit}{plain}")
 
 
-__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_value", "conflict_message",
+__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_flag", "check_value", "conflict_message",
            "implausible_message", "nan_message", "range_message", "read_count", "read_value",
            "unreadable_message"]

@@ -15,7 +15,7 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from fruitimpact.impact.validation import InputError, check_choice, conflict_message, read_count
+from fruitimpact.impact.validation import InputError, check_choice, check_flag, conflict_message, read_count
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
                                    Plan, Threshold, characteristic, characteristics_list)
 
@@ -70,6 +70,7 @@ def run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=No
         keep_columns=(), percentiles=PERCENTILES):
     """Execute ``plan`` (``runs.execute``) after ``check_run``; returns the ``RunSummary``.  ``fresh`` discards
     the parts of another job in the work folder (only a folder fruitimpact made and marked)."""
+    fresh = check_flag("fresh", fresh)
     checked = check_run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir)
     return start(plan, output, checked, fresh=fresh, keep_columns=keep_columns, percentiles=percentiles)
 
@@ -326,12 +327,13 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
     """(plan, lines describing the library spreads) of a population; ``inputs``: input → a constant or a
     distribution text (``"normal(115g,10g)"``).  The drawn distributions are ``plan.source.distributions``."""
     from fruitimpact.impact.distributions import Constant, parse_distribution
-    from fruitimpact.impact.lots import PopulationSource
+    from fruitimpact.impact.lots import MAX_SEED, PopulationSource
     from fruitimpact.impact.presets import lot_distributions
     from fruitimpact.impact.quantities import DEFAULT_SUMMARY
 
+    spreads = check_flag("spreads", spreads)
     rows = read_count("rows", rows, 1, MAX_ROWS)
-    seed = read_count("seed", seed, 0)
+    seed = read_count("seed", seed, 0, MAX_SEED)
     distributions, constants, text = [], {}, {}
     for name, spec in _texts(inputs).items():
         quantity = _input(name)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import InputError, conflict_message
+from fruitimpact.impact.validation import InputError, check_flag, conflict_message
 
 #: The analysis options (Python name → CLI option), with their defaults as the CLI gives them.
 ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "rebound_window": "--rebound-window", "pitch": "--pitch",
@@ -67,8 +67,8 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     unknown = [name for name in options if name not in ANALYSIS_OPTIONS]
     if unknown:
         raise InputError(f"unknown analysis option {unknown[0]!r} (options: {', '.join(ANALYSIS_OPTIONS)})")
-    if not isinstance(options.get("fit", False), (bool, type(None))):
-        raise InputError(f"argument --fit: fit must be True or False; got {options['fit']!r}")
+    if options.get("fit") is not None:
+        check_flag("fit", options["fit"])
     # the Python API may give a sequence where the CLI gives "A,B"
     options = {name: ",".join(str(v) for v in value) if name in ("clip", "thresholds", "classes")
                and not isinstance(value, (str, bytes)) and hasattr(value, "__iter__") else value
