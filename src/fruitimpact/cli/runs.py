@@ -161,7 +161,9 @@ def cmd_population(args) -> int:
     summary = _run(args, plan, percentiles=percentiles)
     if summary is None:
         return 130
-    summary.details = tasks.population_details(plan, spread_lines)
+    from fruitimpact.impact.lots import lot_details
+
+    summary.details = lot_details(plan.source, spread_lines)
     names = plan.stats
     if args.hist:
         _save("--hist", runs.histogram_figure(summary.sample, names, summary.percentiles["exact"]), args.hist)

@@ -107,20 +107,14 @@ def _checked_inputs(inputs: dict, finder: str, axis: tuple[str, ...] = ()):
     fruit's own when none is given, issue 14 item 5c).  ``probe`` is the row's evaluation at 1 cm: its
     warnings are the inputs' own."""
     from fruitimpact.impact.presets import fruit_criterion
-    from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.validation import InputError
+    from fruitimpact.impact.validation import InputError, check_input_name
 
     for name in ("velocity", "drop_height", *axis):
         if inputs.get(name) is not None:
             raise InputError(f"{name} is what {finder}: leave it out", name)
-    unknown = [name for name in inputs if name not in INPUTS]
-    if unknown:
-        raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(INPUTS)})", unknown[0])
-    criterion = inputs.get("criterion")
-    if criterion == "none":
-        raise InputError("criterion must be given for a safe height: pressure, shear or energy (the onset height "
-                         "changes by an order of magnitude between them)", "criterion")
-    inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), criterion)}
+    for name in inputs:
+        check_input_name(name)
+    inputs = {**inputs, "criterion": fruit_criterion(inputs.get("fruit"), inputs.get("criterion"), "a safe height")}
     given = {name: value for name, value in inputs.items() if value is not None}
     return given, _check_row(given)
 

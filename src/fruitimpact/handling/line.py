@@ -331,47 +331,25 @@ def audit_line(line, *, rows: int = LINE_FRUIT, seed: int = 0, criterion: str | 
     docs/library.md.
     """
     from fruitimpact.handling.heights import AXIS_INPUTS
-    from fruitimpact.impact.distributions import parse_distribution
-    from fruitimpact.impact.lots import MAX_SEED, PopulationSource
-    from fruitimpact.impact.presets import fruit_criterion, lot_distributions
-    from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.registries import REGISTRIES
-    from fruitimpact.impact.validation import InputError, check_choice, check_flag, read_count
+    from fruitimpact.impact.lots import MAX_SEED, lot_details, read_lot
+    from fruitimpact.impact.presets import fruit_criterion
+    from fruitimpact.impact.validation import InputError, check_flag, read_count
 
     spreads = check_flag("spreads", spreads)
     rows = read_count("rows", rows, 1, MAX_LINE_FRUIT)
     seed = read_count("seed", seed, 0, MAX_SEED)
     points = _points(line)
-    if criterion == "none":
-        raise InputError("criterion must be given for a line audit: pressure, shear or energy (the onset height "
-                         "changes by an order of magnitude between them)", "criterion")
-    criterion = fruit_criterion(inputs.get("fruit"), criterion)
-    distributions, constants = [], {}
-    for name, spec in inputs.items():
-        if name not in INPUTS:
-            raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
-        if spec is None:
-            continue
-        if name in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):  # would override every point's surface
-            raise InputError(f"{name} is set by each transfer point of the line", name)
-        quantity = INPUTS[name]
-        if not quantity.numeric:
-            constants[name] = check_choice(name, spec, REGISTRIES[name]) if name in REGISTRIES else spec
-            continue
-        try:
-            distributions.append((name, parse_distribution(str(spec), quantity.dimension, name)))
-        except ValueError as exc:
-            raise InputError(str(exc), name) from None
+    criterion = fruit_criterion(inputs.get("fruit"), criterion, "a line audit")
     if isinstance(alternatives, str):
         alternatives = () if alternatives.strip().lower() == "none" else \
             tuple(a.strip() for a in alternatives.split(","))
         if any(not a for a in alternatives):
             raise InputError("alternatives must be library surface names, comma-separated, or none", "alternatives")
-    extra, density, described = lot_distributions(constants.get("fruit"), [n for n, _ in distributions], criterion,
-                                                  spreads=spreads)
-    drawn = distributions + list(extra)
-    members, _ = PopulationSource(tuple(drawn), (), rows, seed, density).inputs(0, rows, None)
+    # every input checked (with the criterion) before the lot is drawn; each point sets its height and surface
+    source, constants, described = read_lot(inputs, rows=rows, seed=seed, spreads=spreads, criterion=criterion,
+                                            excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
+                                            excluded_reason="is set by each transfer point of the line")
+    members, _ = source.inputs(0, rows, None)
     report = audit(points, members, rows, criterion, constants, tuple(alternatives))
-    report.update(rows=rows, seed=seed, inputs={name: dist.describe() for name, dist in drawn},
-                  spreads=list(described))
+    report.update(rows=rows, **lot_details(source, described))
     return report

@@ -42,8 +42,8 @@ from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_
 from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_forms
 from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from fruitimpact.impact.labels import Labels
-from fruitimpact.impact.validation import (MessageBook, WarningBook, conflict_message, implausible_message, nan_message,
-                         range_message)
+from fruitimpact.impact.validation import (InputError, MessageBook, WarningBook, conflict_message, implausible_message,
+                                           nan_message, range_message)
 
 #: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is
 #: ``damping``, given or calibrated).
@@ -673,6 +673,26 @@ def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluati
     return evaluate_inputs(inputs, messages, tabulated=tabulated)
 
 
+#: Inputs whose range depends on other inputs (alpha on the law, step on the impact): not refused alone.
+DEPENDENT_INPUTS = ("alpha", "step")
+
+
+def refuse_constants(constants: dict, text: dict, given=()) -> None:
+    """Refuse, before a run of many rows, a constant input out of its range or an input that the constants need
+    and nobody gave (the energy criterion's threshold, a failure stress the fruit lacks): it would refuse every
+    row.  One row of ``constants`` and ``text`` goes through :func:`evaluation`; ``given`` names every input the
+    rows will have (drawn or swept ones too).  ``InputError`` with that row's message."""
+    if not constants and not text:
+        return
+    probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
+    message = probe.messages.text(0)
+    first = message.split(" ", 1)[0]
+    if probe.status[0] != INVALID or first in DEPENDENT_INPUTS:
+        return
+    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
+        raise InputError(message, first)
+
+
 def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.DataFrame":  # noqa: F821
     """Characteristics of every row of ``table``.
 
@@ -747,5 +767,5 @@ def curves(table, times=None, points: int = 201):
     return dict(row=rows, time=grid, deflection=deflection, rate=rate, force=force)
 
 
-__all__ = ["Evaluation", "HERTZ_RANGE", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES",
-           "curves", "evaluate", "evaluate_inputs", "evaluation"]
+__all__ = ["DEPENDENT_INPUTS", "Evaluation", "HERTZ_RANGE", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES",
+           "curves", "evaluate", "evaluate_inputs", "evaluation", "refuse_constants"]

@@ -103,3 +103,55 @@ class PopulationSource:
     def keys(self, start: int, stop: int) -> np.ndarray:
         """Uniform [0, 1) keys of rows start..stop-1, for the percentile sample."""
         return self._stream(start, stop, KEY_STREAM, lambda rng, n: rng.random(n))
+
+
+def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: str | None = None,
+             excluded=(), excluded_reason: str = ""):
+    """(source, text inputs, lines describing the library spreads) of a lot of ``rows`` fruit, from ``inputs``
+    (input → a constant ``0.115``/``"115g"``, a distribution text ``"normal(115g,10g)"``, or a name for the text
+    inputs), as ``population`` and a line audit both take them.
+
+    Every input is checked before anything is drawn: an unknown name, an input of ``excluded`` (``excluded_reason``
+    says why), a text input not in its registry, a distribution that cannot be read, two alternatives given
+    together, a constant out of its range or one the others need (``impact.evaluation.refuse_constants``).  The
+    inputs not given are drawn from the fruit's library spreads unless ``spreads`` is False (the bruise inputs
+    only with a ``criterion``).  ``InputError`` naming the input otherwise."""
+    from fruitimpact.impact.distributions import Constant, parse_distribution
+    from fruitimpact.impact.evaluation import refuse_constants
+    from fruitimpact.impact.presets import lot_distributions
+    from fruitimpact.impact.registries import REGISTRIES
+    from fruitimpact.impact.validation import InputError, check_choice, check_conflicts, check_input_name, spec_text
+
+    distributions, constants, text = [], {}, {}
+    for name, value in inputs.items():
+        quantity = check_input_name(name)
+        if value is None:
+            continue
+        if name in excluded:
+            raise InputError(f"{name} {excluded_reason}", name)
+        spec = spec_text(name, value)
+        if not quantity.numeric:
+            text[name] = check_choice(name, spec, REGISTRIES[name]) if name in REGISTRIES else spec
+            continue
+        try:
+            dist = parse_distribution(spec, quantity.dimension, name)
+        except ValueError as exc:
+            raise InputError(f"{name}: {exc}", name) from None
+        distributions.append((name, dist))
+        if isinstance(dist, Constant):
+            constants[name] = dist.value
+    criterion = criterion if criterion is not None else text.get("criterion")
+    given = [name for name, _ in distributions] + list(text)
+    check_conflicts(given)
+    refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
+    extra, density, described = lot_distributions(text.get("fruit"), [name for name, _ in distributions],
+                                                  criterion, spreads=spreads)
+    source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
+    return source, text, tuple(described)
+
+
+def lot_details(source: PopulationSource, described) -> dict:
+    """What a lot was drawn from, for a report: the seed, each drawn input's distribution and the lines
+    describing the library spreads."""
+    return {"seed": source.seed, "inputs": {name: dist.describe() for name, dist in source.distributions},
+            "spreads": list(described)}

@@ -220,19 +220,22 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
     return LotSpreads(fruit, tuple(out), density, tuple(lines))
 
 
-def fruit_criterion(fruit: str | None, criterion: str | None) -> str:
-    """The bruise criterion to use: ``criterion`` as given, or, when it is None or ``preset``, the one the
-    literature supports for ``fruit`` (its library entry; the default fruit when None).  ValueError naming
-    ``criterion`` when that fruit has none (a command that needs a criterion refuses then)."""
-    if criterion not in (None, "preset"):
-        return criterion
-    from fruitimpact.impact.validation import check_choice
+def fruit_criterion(fruit: str | None, criterion: str | None, task: str = "") -> str:
+    """The bruise criterion a ``task`` that needs one uses (a safe height, a line audit): ``criterion`` as given
+    (checked against the registry), or, when it is None or ``preset``, the one the literature supports for
+    ``fruit`` (its library entry; the default fruit when None).  ValueError naming ``criterion`` for ``none``,
+    a misspelt criterion, or a fruit that names none."""
+    from fruitimpact.impact.registries import REGISTRIES
+    from fruitimpact.impact.validation import InputError, check_choice
 
+    if criterion == "none":
+        raise InputError(f"criterion must be given for {task or 'this task'}: pressure, shear or energy (the onset "
+                         f"height changes by an order of magnitude between them)", "criterion")
+    if criterion not in (None, "preset"):
+        return check_choice("criterion", criterion, REGISTRIES["criterion"])
     name = check_choice("fruit", fruit or INPUTS["fruit"].default, library.fruits())  # a misspelt fruit is said so
     entry = library.fruits()[name]
     if entry.criterion is None:
-        from fruitimpact.impact.validation import InputError
-
         raise InputError(f"criterion must be given: the {name} entry of the fruit library names no bruise criterion "
                          f"the literature supports (pressure, shear or energy; the onset height changes by an "
                          f"order of magnitude between them)", "criterion")

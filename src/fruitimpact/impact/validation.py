@@ -140,6 +140,43 @@ def check_flag(name: str, value) -> bool:
     return bool(value)
 
 
+def check_input_name(name: str) -> Quantity:
+    """The quantity of input ``name`` (``quantities.INPUTS``); ``InputError`` naming it if it is unknown."""
+    quantity = INPUTS.get(name)
+    if quantity is None:
+        raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
+    return quantity
+
+
+def spec_text(name: str, value) -> str:
+    """A Python value of input ``name`` as the CLI's text (a sweep axis, a distribution, a constant): a string
+    as it is, a number by ``repr``, a sequence joined by commas; ``InputError`` for anything else."""
+    def text(item) -> str:
+        if isinstance(item, str):
+            return item
+        if isinstance(item, (list, tuple)) or (hasattr(item, "__array__") and getattr(item, "ndim", 0) == 1):
+            return ",".join(text(part) for part in item)
+        if isinstance(item, (bool, np.bool_)):
+            raise TypeError
+        return repr(float(item))
+
+    try:
+        return text(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, a text with units or a range; got {value!r}", name) from None
+
+
+def check_conflicts(given) -> None:
+    """Refuse two of the inputs ``given`` that are alternatives (``quantities.ALTERNATIVES``: velocity and
+    drop_height, ...), naming both."""
+    from fruitimpact.impact.quantities import ALTERNATIVES
+
+    for group in ALTERNATIVES:
+        named = [name for name in group if name in given]
+        if len(named) > 1:
+            raise InputError(conflict_message(named), tuple(named))
+
+
 #: Most digits of a count read from text (Python's own limit for converting text to int is 4300).
 _MAX_DIGITS = 4000
 
@@ -257,6 +294,7 @@ def implausible_message(quantity: Quantity, value: float | None = None) -> str:
             f"[{plausible.low:g}, {plausible.high:g}]{unit}{plain}")
 
 
-__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_flag", "check_value", "conflict_message",
+__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag",
+           "check_input_name", "spec_text", "check_value", "conflict_message",
            "implausible_message", "nan_message", "range_message", "read_count", "read_value",
            "unreadable_message"]

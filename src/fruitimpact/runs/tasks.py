@@ -15,12 +15,11 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from fruitimpact.impact.validation import InputError, check_choice, check_flag, conflict_message, read_count
+from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name,
+                                           read_count, spec_text)
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
                                    Plan, Threshold, characteristic, characteristics_list)
 
-#: Inputs whose range depends on other inputs: not checked alone when constant.
-_DEPENDENT_INPUTS = ("alpha", "step")
 #: Most worker processes of a local Dask cluster.
 MAX_WORKERS = 256
 #: Most grid points ``sweep`` returns as a DataFrame (about 1 kB a row); larger grids go to a file.
@@ -85,78 +84,12 @@ def start(plan, output, checked, *, fresh: bool = False, keep_columns=(), percen
                    percentiles=percentiles)
 
 
-# --- the inputs of a grid or a population --------------------------------------------------------------------------
-
-def _input(name: str):
-    from fruitimpact.impact.quantities import INPUTS
-
-    quantity = INPUTS.get(name)
-    if quantity is None:
-        raise InputError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})", name)
-    return quantity
-
-
-def _check_text(name: str, values) -> None:
-    from fruitimpact.impact.registries import REGISTRIES
-
-    for value in values:
-        check_choice(name, value, REGISTRIES[name])
-
-
-def _check_conflicts(given) -> None:
-    """Refuse two inputs of one group of alternatives (velocity and drop_height, ...)."""
-    from fruitimpact.impact.quantities import ALTERNATIVES
-
-    for group in ALTERNATIVES:
-        named = [name for name in group if name in given]
-        if len(named) > 1:
-            raise InputError(conflict_message(named), tuple(named))
-
-
-def _check_constants(constants: dict, text: dict, given=()) -> None:
-    """Refuse a constant input out of its range, or an input that a constant needs and nobody gave (the
-    energy criterion's threshold), before any chunk runs (one row through ``impact.evaluation``)."""
-    from fruitimpact.impact.evaluation import evaluation
-    from fruitimpact.impact.quantities import INPUTS
-    from fruitimpact.impact.status import INVALID
-
-    if not constants and not text:
-        return
-    probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
-    message = probe.messages.text(0)
-    first = message.split(" ", 1)[0]
-    if probe.status[0] != INVALID or first in _DEPENDENT_INPUTS:
-        return
-    # a refusal naming an input nobody gave is one the constants cause (a threshold the energy criterion needs,
-    # a failure stress the fruit lacks): it would refuse every member
-    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
-        raise InputError(message, first)
-
-
-def _spec_text(value) -> str:
-    """A library value of a sweep axis or a distribution as the CLI's text: numbers by ``repr``, a
-    sequence joined by commas."""
-    if isinstance(value, str):
-        return value
-    if isinstance(value, (list, tuple)) or (hasattr(value, "__array__") and getattr(value, "ndim", 0) == 1):
-        return ",".join(_spec_text(item) for item in value)
-    if isinstance(value, bool):
-        raise TypeError
-    return repr(float(value))
-
+# --- the inputs of a grid ------------------------------------------------------------------------------------------
 
 def _texts(inputs: Mapping) -> dict[str, str]:
-    out = {}
-    for name, value in inputs.items():
-        _input(name)
-        if value is None:
-            continue
-        try:
-            out[name] = _spec_text(value)
-        except (TypeError, ValueError):
-            raise InputError(f"{name} must be a number, a text with units or a range; got {value!r}",
-                             name) from None
-    return out
+    """The given inputs (None: not given) as the CLI's texts, each name checked."""
+    return {name: spec_text(name, value) for name, value in inputs.items()
+            if check_input_name(name) and value is not None}
 
 
 # --- batch -----------------------------------------------------------------------------------------------------------
@@ -230,6 +163,8 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
 def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = True):
     """(plan, swept axes) of a sweep over ``axes_text`` (input → ``START:STOP:COUNT``, ``log:...``, a comma
     list or one value, in the order given: the first varies slowest)."""
+    from fruitimpact.impact.evaluation import refuse_constants
+    from fruitimpact.impact.registries import REGISTRIES
     from fruitimpact.runs.sources import Axis, GridSource, parse_axis
 
     chunk_size = read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS)
@@ -240,15 +175,16 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
         except ValueError as exc:
             raise InputError(f"{name}: {exc}", name) from None
         if not axis.numeric:
-            _check_text(name, axis.values)
+            for value in axis.values:
+                check_choice(name, value, REGISTRIES[name])
         if len(axis.values) > 1:
             axes.append(axis)
         elif axis.numeric:
             constants[name] = axis.values[0]
         else:
             text[name] = axis.values[0]
-    _check_conflicts(list(axes_text))
-    _check_constants(constants, text, list(axes_text))
+    check_conflicts(list(axes_text))
+    refuse_constants(constants, text, list(axes_text))
     points = math.prod(len(a.values) for a in axes)
     if points > MAX_ROWS:
         raise InputError(f"the grid has {points:,} points ({' × '.join(str(len(a.values)) for a in axes)}); "
@@ -326,33 +262,13 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
                     thresholds=(), sample_size=SAMPLE_ROWS, chunk_size=CHUNK_ROWS, write_rows: bool = False):
     """(plan, lines describing the library spreads) of a population; ``inputs``: input → a constant or a
     distribution text (``"normal(115g,10g)"``).  The drawn distributions are ``plan.source.distributions``."""
-    from fruitimpact.impact.distributions import Constant, parse_distribution
-    from fruitimpact.impact.lots import MAX_SEED, PopulationSource
-    from fruitimpact.impact.presets import lot_distributions
+    from fruitimpact.impact.lots import MAX_SEED, read_lot
     from fruitimpact.impact.quantities import DEFAULT_SUMMARY
 
     spreads = check_flag("spreads", spreads)
     rows = read_count("rows", rows, 1, MAX_ROWS)
     seed = read_count("seed", seed, 0, MAX_SEED)
-    distributions, constants, text = [], {}, {}
-    for name, spec in _texts(inputs).items():
-        quantity = _input(name)
-        if not quantity.numeric:
-            _check_text(name, [spec])
-            text[name] = spec
-            continue
-        try:
-            dist = parse_distribution(spec, quantity.dimension, name)
-        except ValueError as exc:
-            raise InputError(f"{name}: {exc}", name) from None
-        distributions.append((name, dist))
-        if isinstance(dist, Constant):
-            constants[name] = dist.value
-    _check_conflicts([d for d, _ in distributions])
-    _check_constants(constants, text, [d for d, _ in distributions] + list(text))
-    extra, density, described = lot_distributions(text.get("fruit"), [d for d, _ in distributions],
-                                                  text.get("criterion"), spreads=spreads)
-    distributions += list(extra)
+    source, _, described = read_lot(inputs, rows=rows, seed=seed, spreads=spreads)
     try:
         if characteristics is None:
             names = DEFAULT_SUMMARY
@@ -368,7 +284,6 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
             parsed.append(item if isinstance(item, Threshold) else Threshold.parse(str(item)))
         except ValueError as exc:
             raise InputError(f"threshold: {exc}", "threshold") from None
-    source = PopulationSource(tuple(distributions), tuple(text.items()), rows, seed, density)
     plan = Plan("population", source, read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS), write_rows=write_rows,
                 stats=tuple(names), thresholds=tuple(parsed),
                 sample_rows=read_count("sample_size", sample_size, 1, MAX_SAMPLE_ROWS))
@@ -445,21 +360,16 @@ def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=Non
     Each member as :func:`fruitimpact.evaluate`; the lot spreads: docs/library.md.
     """
     percentiles = check_percentiles(percentiles)
+    from fruitimpact.impact.lots import lot_details
+
     plan, described = population_plan(
         inputs, rows=rows, seed=seed, spreads=spreads, characteristics=characteristics, thresholds=thresholds,
         sample_size=sample_size, chunk_size=chunk_size, write_rows=output is not None)
     summary = run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh,
                   percentiles=percentiles)
-    summary.details = population_details(plan, described)
+    summary.details = lot_details(plan.source, described)
     return summary
 
 
-def population_details(plan, described) -> dict:
-    """What a population run was asked, for its summary (``RunSummary.details``): the seed, each drawn input's
-    distribution and the lines describing the library spreads."""
-    return {"seed": plan.source.seed, "inputs": {name: dist.describe() for name, dist in plan.source.distributions},
-            "spreads": list(described)}
-
-
 __all__ = ["MAX_FRAME_ROWS", "MAX_WORKERS", "batch", "batch_plan", "check_percentiles", "check_run", "population",
-           "population_details", "population_plan", "run", "start", "sweep", "sweep_plan"]
+           "population_plan", "run", "start", "sweep", "sweep_plan"]
