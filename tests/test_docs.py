@@ -28,7 +28,8 @@ def test_the_docs_site_builds_strict_with_its_examples_run(tmp_path):
     api = (tmp_path / "site" / "api" / "index.html").read_text()
     for path in ("impact.simulation.simulate", "handling.drops.drop", "handling.heights.safe_height",
                  "handling.line.audit_line", "signals.offline.analyze", "signals.read.read_recording",
-                 "signals.fit.fit_impact"):  # each rendered with its own anchor, from its docstring
+                 "signals.fit.fit_impact", "runs.tasks.batch", "runs.tasks.sweep", "runs.tasks.population"):
+        # each rendered with its own anchor, from its docstring
         assert f'id="fruitimpact.{path}"' in api, path
     # rendered for the theme (docs/hooks/rendering.py): an id starting with a digit stopped the theme's scripts
     # on two pages, and Sphinx roles showed literally in the API reference
@@ -38,6 +39,10 @@ def test_the_docs_site_builds_strict_with_its_examples_run(tmp_path):
         html = page.read_text()
         assert not re.search(r'id="\d', html), page
         assert not re.search(r":(?:func|mod|class):<code>", html), page
+        assert "<code>~" not in html, page  # a Sphinx short reference shown with its tilde
+        assert "Parameters (" not in html, page  # a section title numpy does not know shows as a box
+    # a parameter table has one row per parameter: grouped names ("engine, scheduler, ...") gave each the same text
+    assert "engine, scheduler" not in api
     # the examples ran: their printed output is on the page
     assert "safe height onto steel" in (tmp_path / "site" / "tasks" / "drops" / "index.html").read_text()
 

@@ -4,7 +4,7 @@
   theme's scroll tracking throws on them and stops its other scripts (tables lose their styling).  They get an
   ``s-`` prefix, in the page and in its table of contents.
 * Docstrings name other objects with Sphinx roles (``:func:`safe_height```), which mkdocstrings shows
-  literally; the role is dropped and the name kept as code.
+  literally; the role is dropped and the name kept as code (``~a.b.Name`` as ``Name``, as Sphinx shows it).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import re
 
 _DIGIT_ID = re.compile(r'(id="|href="#)(\d)')
 _ROLE = re.compile(r":(?:func|mod|class|meth|data|attr|obj):(?=<code>)")
+_SHORT = re.compile(r"<code>~(?:[\w.]+\.)?(\w+)</code>")
 
 
 def _retarget(items) -> None:
@@ -24,4 +25,4 @@ def _retarget(items) -> None:
 
 def on_page_content(html, page, config, files):
     _retarget(page.toc)
-    return _ROLE.sub("", _DIGIT_ID.sub(r"\1s-\2", html))
+    return _SHORT.sub(r"<code>\1</code>", _ROLE.sub("", _DIGIT_ID.sub(r"\1s-\2", html)))

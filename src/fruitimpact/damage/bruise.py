@@ -105,7 +105,7 @@ def hertz_axis_stresses(depth_ratio, poisson):
 
     Returns
     -------
-    (sigma_z, sigma_r) : tuple of float or array
+    sigma_z, sigma_r : tuple of float or array
         Axial and radial (= hoop) stress over the peak pressure p0 [-], broadcast shape.
     """
     zeta, nu = np.broadcast_arrays(_values("depth_ratio", depth_ratio, 0.0), _poisson(poisson))
@@ -169,7 +169,7 @@ def hertz_max_shear(poisson):
 
     Returns
     -------
-    (shear_ratio, depth_ratio) : tuple of float or array
+    shear_ratio, depth_ratio : tuple of float or array
         τ_max/p0 [-] and the depth of the maximum z/a [-], each shaped like ``poisson``.
     """
     nu = _poisson(poisson)
@@ -285,13 +285,20 @@ class BruiseCriterion:
                threshold_energy=None):
         """Dimensionless margin quantity/threshold − 1 [-]: ≥ 0 means bruised (NaN where an input is NaN).
 
-        Parameters (only those in ``inputs`` are needed; ValueError if one of them is missing)
+        Only the criterion's own ``inputs`` are needed; ValueError if one of them is missing.
+
+        Parameters
         ----------
-        peak_pressure : peak Hertz contact pressure p0 [Pa], ≥ 0.
-        poisson : Poisson's ratio ν of the flesh [-], in [0, 0.5].
-        absorbed_energy : energy absorbed by the fruit W [J] (finite; ≤ 0 counts as none).
-        failure_stress : flesh failure (bioyield) stress σ_f [Pa], > 0.
-        threshold_energy : bruise threshold energy W_th [J], > 0.
+        peak_pressure : float or array
+            Peak Hertz contact pressure p0 [Pa], ≥ 0.
+        poisson : float or array
+            Poisson's ratio ν of the flesh [-], in [0, 0.5].
+        absorbed_energy : float or array
+            Energy absorbed by the fruit W [J] (finite; ≤ 0 counts as none).
+        failure_stress : float or array
+            Flesh failure (bioyield) stress σ_f [Pa], > 0.
+        threshold_energy : float or array
+            Bruise threshold energy W_th [J], > 0.
         """
         given = dict(zip(_INPUTS, (peak_pressure, poisson, absorbed_energy, failure_stress, threshold_energy)))
         missing = [name for name in self.inputs if given[name] is None]
@@ -468,7 +475,7 @@ def bruise_geometry(volume, contact_radius, width_ratio=CONTACT_TO_BRUISE_WIDTH)
 
     Returns
     -------
-    (depth, width) : tuple of float or array [m]
+    depth, width : tuple of float or array [m]
     """
     v = _values("volume", volume, 0.0, unit="m³")
     a = _values("contact_radius", contact_radius, 0.0, unit="m")

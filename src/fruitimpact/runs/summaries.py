@@ -14,8 +14,37 @@ from fruitimpact.impact.quantities import CHARACTERISTICS
 
 @dataclass
 class RunSummary:
-    """What a run produced: rows per status (``statuses``; ``ok``, ``invalid``, ``failed`` also as
-    fields); for populations statistics, threshold counts and the percentile method."""
+    """What a run produced: rows per status; for populations statistics, threshold counts and the percentile
+    method.
+
+    Attributes
+    ----------
+    kind : str
+        ``batch``, ``sweep`` or ``population``.
+    rows : int
+        Rows evaluated.
+    ok, invalid, failed : int
+        Rows of those statuses (``statuses`` has every status, ``inaccurate`` too).
+    output : str or None
+        The file every row was written to.
+    resumed_chunks : int
+        Chunks taken from an earlier, interrupted run of the same job.
+    statistics : dict
+        Population: per characteristic ``mean``, ``sd``, ``min``, ``max`` and ``percentiles`` [SI], of the ok rows.
+    thresholds : list of dict
+        Population: each threshold's ``count`` of ``of`` ok rows and ``share``.
+    percentiles : dict
+        Population: how the percentiles were found (``exact``, or from a seeded sample of ``sample_size`` rows).
+    sample : numpy.ndarray or None
+        Population: the rows the percentiles were taken from, one column per characteristic (for histograms).
+    columns : dict
+        Columns read back whole for a figure (a sweep's plotted characteristic).
+    statuses : dict
+        Rows per status name.
+    details : dict
+        What the run was asked: a population's ``seed``, ``inputs`` (each drawn input's distribution) and
+        ``spreads``.
+    """
 
     kind: str
     rows: int

@@ -122,10 +122,19 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
         ``.csv``, ``.parquet`` or ``.pq``: every row with its inputs as used, the characteristics, ``status``,
         ``message`` and ``warnings``, and the input row number in ``row``.  Written atomically.
     chunk_size : int or str
-        Rows per chunk, 1 to 10,000,000 (default 500,000); ``"1e6"`` accepted.
-    engine, scheduler, workers, workdir, fresh
-        As :func:`run`: ``"inprocess"`` or ``"dask"``, a Dask scheduler address, local Dask workers, the work
-        folder of the part files, discard another job's parts.
+        Rows per chunk, 1 to 10,000,000 (default 500,000; ``"1e6"`` accepted); each chunk is written to the work
+        folder as soon as it is done, and an interrupted run resumes from there.
+    engine : str, optional
+        ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
+    scheduler : str, optional
+        A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
+    workers : int or str
+        Worker processes of a local Dask cluster, 1 to 256 (default 2).
+    workdir : str or Path, optional
+        The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
+    fresh : bool
+        Discard the parts of another job in the work folder (only a folder fruitimpact made and marked) instead
+        of refusing.
 
     Returns
     -------
@@ -144,8 +153,9 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
     Examples
     --------
     >>> import fruitimpact as fi
-    >>> summary = fi.batch("examples/batch.csv", "results.parquet")  # doctest: +SKIP
-    >>> summary.ok, summary.invalid  # doctest: +SKIP
+    >>> summary = fi.batch("examples/fruit.csv", "results.parquet")  # doctest: +SKIP
+    >>> summary.rows, summary.ok, summary.invalid  # doctest: +SKIP
+    (12, 12, 0)
 
     References
     ----------
@@ -207,8 +217,20 @@ def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, wo
         Each input of :func:`fruitimpact.evaluate` by name: a range ``"START:STOP:COUNT"`` (inclusive,
         linear; units allowed, ``"2MPa:6MPa:41"``), ``"log:START:STOP:COUNT"`` (geometric), a list of values
         (``[0.5, 1.0]``, ``"chen,flores"``) or one value.  The first swept input given varies slowest.
-    chunk_size, engine, scheduler, workers, workdir, fresh
-        As :func:`batch` (with ``output`` only).
+    chunk_size : int or str
+        With ``output`` only, as the other run options below.  Rows per chunk, 1 to 10,000,000 (default 500,000; ``"1e6"`` accepted); each chunk is written to the work
+        folder as soon as it is done, and an interrupted run resumes from there.
+    engine : str, optional
+        ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
+    scheduler : str, optional
+        A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
+    workers : int or str
+        Worker processes of a local Dask cluster, 1 to 256 (default 2).
+    workdir : str or Path, optional
+        The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
+    fresh : bool
+        Discard the parts of another job in the work folder (only a folder fruitimpact made and marked) instead
+        of refusing.
 
     Returns
     -------
@@ -325,8 +347,20 @@ def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=Non
         Percentiles are exact up to this many members, above it estimated from a seeded uniform sample.
     output : str or Path, optional
         Also write every member's row (CSV or Parquet).
-    chunk_size, engine, scheduler, workers, workdir, fresh
-        As :func:`batch`.
+    chunk_size : int or str
+        Rows per chunk, 1 to 10,000,000 (default 500,000; ``"1e6"`` accepted); each chunk is written to the work
+        folder as soon as it is done, and an interrupted run resumes from there.
+    engine : str, optional
+        ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
+    scheduler : str, optional
+        A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
+    workers : int or str
+        Worker processes of a local Dask cluster, 1 to 256 (default 2).
+    workdir : str or Path, optional
+        The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
+    fresh : bool
+        Discard the parts of another job in the work folder (only a folder fruitimpact made and marked) instead
+        of refusing.
     **inputs
         Each input a constant (``mass=0.115``, ``"115g"``) or a distribution: ``"normal(mean,sd)"``,
         ``"lognormal(median,sigma)"``, ``"uniform(lo,hi)"``, ``"truncnormal(mean,sd,lo,hi)"``,

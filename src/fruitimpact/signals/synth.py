@@ -420,8 +420,9 @@ def synthesize(sensor: SensorModel, impacts, *, lanes: int = 1, duration: float 
     Parameters
     ----------
     sensor : SensorModel
-    impacts : sequence of Impact, or a Population (its ``impacts()``)
-        May be empty (a recording of the disturbances alone; ``duration`` is
+        The sensor the force passes through (noise, drift, hum, ADC, clipping, plate, filter).
+    impacts : sequence of Impact, or Population
+        The impacts (a Population gives its ``impacts()``).  May be empty (a recording of the disturbances alone; ``duration`` is
         then required).  Each impact's lane must be below ``lanes``.
     lanes : int
         Lanes of the recording, named ``lane0`` … (default 1).
