@@ -221,18 +221,22 @@ def test_population_agrees_with_the_cli(cli, tmp_path, monkeypatch):
     (["sweep", "--velocity", "1:2:3", "-o", "x.gif"], lambda: fi.sweep("x.gif", velocity="1:2:3")),
     (["batch", "missing.csv", "-o", "x.csv"], lambda: fi.batch("missing.csv", "x.csv")),
     (["batch", "in.csv", "-o", "x.csv", "--chunk-size", "0"], lambda: fi.batch("in.csv", "x.csv", chunk_size="0")),
+    (["population", "--seed", "1e9999999"], lambda: fi.population(seed="1e9999999")),  # answered at once
 ])
 def test_the_run_functions_refuse_what_the_commands_refuse(cli, tmp_path, monkeypatch, argv, call):
     """One path: the function's ValueError is the command's line, with the option in place of the argument."""
     from fruitimpact.cli.common import usage_message
 
+    import tempfile
+
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # where a run without an output keeps its work folder
     (tmp_path / "in.csv").write_text("mass\n0.1\n")
     line = cli.error(*argv)
     with pytest.raises(ValueError) as caught:
         call()
     assert line.endswith(usage_message(caught.value)), (line, str(caught.value))
-    assert not list(tmp_path.glob(".fruitimpact-*")), "a refused run left a work folder"
+    assert not list(tmp_path.glob("*fruitimpact-*")), "a refused run left a work folder"
 
 
 #: ``fruitimpact synth``'s defaults as library arguments (its --seed S seeds the fruit with S + 1).
@@ -263,6 +267,22 @@ def test_analyze_has_the_same_columns_for_any_recording(options):
         keys = list(report)
         assert set(keys) <= set(columns), set(keys) - set(columns)
         assert keys == sorted(keys, key=columns.index), "a report's keys in another order than the table's"
+
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: fi.sweep(velocity=[[1, 2], [3]]), "velocity must be a number, a text with units or a range"),
+    (lambda: fi.sweep(velocity=np.array([True, False])), "velocity must be a number, a text with units"),
+    (lambda: fi.sweep(velocity=10 ** 400), "velocity must be a number, a text with units"),
+    (lambda: fi.population(thresholds=None), "thresholds are texts"),
+    (lambda: fi.population(percentiles=[True]), "percentiles: each must be a number in"),
+    (lambda: fi.population(characteristics=[]), "give at least one characteristic"),
+    (lambda: fi.population(spreads="no"), "spreads must be True or False"),
+])
+def test_the_run_functions_refuse_python_values_the_text_cannot_mean(call, match):
+    """Values a Python caller can pass that no command line could: refused with a ValueError naming the
+    argument, never a TypeError or OverflowError, never a nested list flattened or True read as 1."""
+    with pytest.raises(ValueError, match=match):
+        call()
 
 
 def test_synthesize_agrees_with_synth(cli, tmp_path):

@@ -85,12 +85,15 @@ def test_user_files_in_our_work_folder_are_kept(tmp_path, cli, monkeypatch):
     assert [p.name for p in (tmp_path / "out.csv.parts").iterdir()] == ["mine.txt"]
 
 
-def test_unrelated_parts_folders_in_the_current_folder_are_left_alone(tmp_path, cli, monkeypatch):
+def test_unrelated_parts_folders_where_work_folders_go_are_left_alone(tmp_path, cli, monkeypatch):
+    import tempfile
+
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # a run without -o keeps its work folder there
     plan = runs.Plan("population", runs.PopulationSource((), (), 100, 0), runs.CHUNK_ROWS, write_rows=False,
                      stats=DEFAULT_SUMMARY, sample_rows=runs.SAMPLE_ROWS)
     same_name = tmp_path / runs.default_workdir(None, plan)
-    other = tmp_path / ".fruitimpact-population-0123456789ab.parts"
+    other = tmp_path / "fruitimpact-population-0123456789ab.parts"
     for folder in (same_name, other):
         folder.mkdir()
         (folder / "data.bin").write_text("someone else's")
@@ -252,3 +255,82 @@ def test_status_line_counts_every_status():
     from fruitimpact.cli.runs import _status_line
 
     assert _status_line(summary) == "6 rows: 3 ok, 1 invalid, 1 failed, 1 inaccurate"
+
+
+def test_a_folder_turned_read_only_mid_run_gives_the_one_line_and_frees_the_lock(tmp_path, monkeypatch):
+    """The output folder made read-only while a run writes (found by an attack run with DAC override dropped): the
+    temporary file and the lock file can no longer be deleted.  That must neither replace the run's one-line error
+    with a PermissionError nor leave the lock held: the same process could not run on that output again."""
+    from pathlib import Path
+
+    from fruitimpact.impact.outputs import atomic_write
+    from fruitimpact.runs.locking import RunLock
+
+    real_unlink = Path.unlink
+
+    def read_only(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    def failing_write(tmp):
+        Path(tmp).write_text("half")
+        raise OSError(13, "Permission denied")
+
+    out = tmp_path / "out.csv"
+    lock = RunLock(tmp_path / ".out.lock", "output").acquire()
+    monkeypatch.setattr(Path, "unlink", read_only)
+    with pytest.raises(ValueError, match="cannot write"):
+        atomic_write(out, failing_write, "-o/--output")
+    lock.release(remove=True)
+    monkeypatch.setattr(Path, "unlink", real_unlink)
+    RunLock(tmp_path / ".out.lock", "output").acquire().release(remove=True)  # free again
+
+
+def test_a_cell_that_is_not_utf8_or_a_column_of_another_type_is_a_bad_row_not_a_dead_batch(tmp_path, cli):
+    """One undecodable byte stopped the whole file at its row (every rerun again), and a Parquet text column of
+    numbers ended in a traceback: now those rows are invalid with their message, the others computed, and a
+    refused row shows no default as an input it "used"."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    source = tmp_path / "in.csv"
+    source.write_bytes(b"mass,velocity,model\n0.1,1,hunt-crossley\n0.1,1,h\xe9rtz\n0.12,1.2\n0.1,2,chen\n")
+    cli.ok("batch", source, "-o", tmp_path / "out.csv")
+    out = pd.read_csv(tmp_path / "out.csv")
+    assert out["status"].tolist() == ["ok", "invalid", "invalid", "ok"]
+    assert "not UTF-8" in out["message"][1] and "fields" in out["message"][2]
+    assert out["mass"].isna().tolist() == [False, True, True, False]  # the unread rows used no input
+    numbers = tmp_path / "model.parquet"
+    pq.write_table(pa.table({"model": [1, 2], "velocity": [1.0, 1.0]}), numbers)
+    cli.ok("batch", numbers, "-o", tmp_path / "m.csv")
+    assert pd.read_csv(tmp_path / "m.csv")["message"].str.startswith("model must be one of").all()
+    nested = tmp_path / "nested.parquet"
+    pq.write_table(pa.table({"mass": [[1.0], [2.0]]}), nested)
+    assert "holds list" in cli.error("batch", nested, "-o", tmp_path / "n.csv")
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["batch", "IN", "-o", "x.csv/"], "argument -o/--output: cannot write 'x.csv/': the name ends in a slash"),
+    (["batch", "IN", "-o", "w.csv", "--workdir", "w.csv"], "argument --workdir: cannot use 'w.csv': it is the output"),
+    (["sweep", "-o", "a.csv"], "give at least one input to sweep"),
+    (["sweep", "--velocity", "1,nan", "-o", "a.csv"], "argument --velocity: each value must be a number, not NaN"),
+    (["sweep", "--veloc", "1,2", "-o", "a.csv"], "unrecognized arguments: --veloc"),  # no completion to --velocity
+    (["population", "-n", "10", "--threshold", "peak_force>nan"], "a threshold's value must be a finite number"),
+    (["population", "-n", "10", "--mass", "sample(rag.csv:mass)"], "sample: cannot read 'rag.csv': Error tokenizing"),
+    (["line", "dup.csv", "-n", "10", "--fruit", "apple"], "transfer point 'a' is named twice"),
+])
+def test_more_bad_runs_are_one_line_before_work(tmp_path, cli, monkeypatch, argv, words):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "IN").write_text("")
+    (tmp_path / "in.csv").write_text("mass\n0.1\n")
+    (tmp_path / "rag.csv").write_text("mass,velocity\n0.1,1\n0.12,1,3\n")
+    (tmp_path / "dup.csv").write_text("name,drop_height,surface\na,10cm,steel\na,5cm,wood\n")
+    argv = ["in.csv" if a == "IN" else a for a in argv]
+    assert words in cli.error(*argv)
+    assert not (tmp_path / "x.csv").exists() and not (tmp_path / "w.csv").exists()
+
+
+def test_a_figure_with_nothing_to_draw_is_not_written(tmp_path, cli):
+    status, _, err = cli.run("sweep", "--velocity", "0.5:1.5:4", "--plot", tmp_path / "p.png", "--characteristic",
+                             "bruise_volume")  # no criterion: no bruise volume anywhere
+    assert status == 1 and "no figure: bruise_volume is not a finite number" in err
+    assert not (tmp_path / "p.png").exists()

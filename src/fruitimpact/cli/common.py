@@ -25,6 +25,11 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        # "--mas 0.1" is a misspelt option, not --mass: refused, never completed to a neighbour
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+
     def error(self, message):  # one line, no usage block
         raise UsageError(message)
 

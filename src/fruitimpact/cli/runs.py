@@ -112,7 +112,14 @@ def cmd_sweep(args) -> int:
     shape = " × ".join(f"{len(a.values)} {a.name}" for a in axes) or "1 point"
     print(f"sweep: {shape}; {_status_line(summary)}" + (f"; written to {summary.output}" if summary.output else ""))
     if args.plot:
-        _save("--plot", runs.sweep_figure(plan.source, summary.columns[name], name), args.plot)
+        import numpy as np
+
+        values = np.asarray(summary.columns[name], dtype=float)
+        if not np.isfinite(values).any():  # an empty frame is not a figure of the sweep
+            print(f"{PROG} sweep: no figure: {name} is not a finite number at any grid point (a bruise figure needs "
+                  f"--criterion; see the rows' messages)", file=sys.stderr)
+            return 1
+        _save("--plot", runs.sweep_figure(plan.source, values, name), args.plot)
         print(f"figure written to {args.plot}")
     return 0
 

@@ -53,7 +53,7 @@ def _points(line) -> list[TransferPoint]:
     if len(line) > MAX_POINTS:
         raise InputError(f"line has {len(line)} transfer points; at most {MAX_POINTS}", "line")
     try:
-        return [_checked_point(point, f"transfer point {point.name!r}") for point in line]
+        return _distinct([_checked_point(point, f"transfer point {point.name!r}") for point in line], "line")
     except ValueError as exc:
         raise InputError(str(exc), "line") from None
 
@@ -105,6 +105,17 @@ def read_line(path) -> list[TransferPoint]:
         if flag not in _TRUE | _FALSE:
             raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
         points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag in _TRUE), where))
+    return _distinct(points, str(path))
+
+
+def _distinct(points: list, where: str) -> list:
+    """``points`` if their names differ: a report names each point (its figures, the changes), and two of one
+    name could not be told apart.  ValueError otherwise."""
+    seen = set()
+    for point in points:
+        if point.name in seen:
+            raise ValueError(f"{where}: transfer point {point.name!r} is named twice; give each point its own name")
+        seen.add(point.name)
     return points
 
 

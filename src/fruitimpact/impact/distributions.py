@@ -241,7 +241,11 @@ def _read_sample(argument: str, dimension: str, default_column: str | None) -> S
     suffix = Path(path).suffix.lower()
     if suffix not in (".csv", ".parquet", ".pq"):
         raise ValueError(f"sample: {path!r} must be .csv or .parquet")
-    frame = pd.read_parquet(path) if suffix != ".csv" else pd.read_csv(path)
+    try:
+        frame = pd.read_parquet(path) if suffix != ".csv" else pd.read_csv(path)
+    except (ValueError, OSError, UnicodeDecodeError) as exc:  # a ragged row, not UTF-8, not Parquet: one line
+        lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+        raise ValueError(f"sample: cannot read {path!r}: {lines[0] if lines else type(exc).__name__}") from None
     if column is None:
         if default_column is not None and default_column in frame:
             column = default_column

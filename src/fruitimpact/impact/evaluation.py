@@ -670,7 +670,14 @@ def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluati
             if text:
                 messages.set_row(i, str(text))
     inputs, messages = read_columns(table, messages, rows)
-    return evaluate_inputs(inputs, messages, tabulated=tabulated)
+    result = evaluate_inputs(inputs, messages, tabulated=tabulated)
+    if errors is not None:
+        unread = np.array([bool(text) for text in errors], dtype=bool)
+        if unread.any():  # a row the reader refused was never read: no input of it was "used"
+            for name in NUMERIC_INPUTS:
+                if name in result.columns:
+                    result.columns[name] = np.where(unread, np.nan, result.columns[name])
+    return result
 
 
 #: Inputs whose range depends on other inputs (alpha on the law, step on the impact): not refused alone.

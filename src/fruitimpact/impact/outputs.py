@@ -118,6 +118,8 @@ def check_output(path, argument: str, formats: dict[str, str] | None = None) -> 
     """
     if path is None or str(path) == "":
         raise output_error(argument, path, "empty file name")
+    if str(path).endswith(("/", os.sep)):  # Path() would drop the slash and make a folder's name a file's
+        raise output_error(argument, path, "the name ends in a slash (a folder); give a file name")
     path = Path(path)
     if formats is not None:
         output_format(path, argument, formats)
@@ -172,7 +174,7 @@ def atomic_write(path, write, argument: str = "path") -> Path:
     finally:
         try:
             tmp.unlink()
-        except FileNotFoundError:
+        except OSError:  # gone (renamed), or the folder turned read-only: the next run removes it (marked ours)
             pass
     return path
 

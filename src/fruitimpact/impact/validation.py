@@ -151,18 +151,18 @@ def check_input_name(name: str) -> Quantity:
 def spec_text(name: str, value) -> str:
     """A Python value of input ``name`` as the CLI's text (a sweep axis, a distribution, a constant): a string
     as it is, a number by ``repr``, a sequence joined by commas; ``InputError`` for anything else."""
-    def text(item) -> str:
+    def scalar(item) -> str:
         if isinstance(item, str):
             return item
-        if isinstance(item, (list, tuple)) or (hasattr(item, "__array__") and getattr(item, "ndim", 0) == 1):
-            return ",".join(text(part) for part in item)
-        if isinstance(item, (bool, np.bool_)):
-            raise TypeError
+        if isinstance(item, (bool, np.bool_)) or not isinstance(item, (int, float, np.integer, np.floating)):
+            raise TypeError  # True is not 1.0; a nested list is not a value
         return repr(float(item))
 
     try:
-        return text(value)
-    except (TypeError, ValueError):
+        if isinstance(value, (list, tuple)) or (hasattr(value, "__array__") and getattr(value, "ndim", 0) == 1):
+            return ",".join(scalar(item) for item in value)
+        return scalar(value.item() if hasattr(value, "__array__") and getattr(value, "ndim", 1) == 0 else value)
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{name} must be a number, a text with units or a range; got {value!r}", name) from None
 
 

@@ -27,10 +27,13 @@ ESTIMATE_AFTER = 60.0
 
 
 def default_workdir(output, plan) -> Path:
-    """``OUTPUT.parts`` beside the output; without one, a job-named folder here."""
+    """``OUTPUT.parts`` beside the output; without one, a job-named folder in the system's temporary folder (a
+    run that writes no file of the user's needs no writable current folder; the same job finds it to resume)."""
     if output is not None:
         return Path(str(output) + ".parts")
-    return Path(f".fruitimpact-{plan.kind}-{plan.fingerprint()[:12]}.parts")
+    import tempfile
+
+    return Path(tempfile.gettempdir()) / f"fruitimpact-{plan.kind}-{plan.fingerprint()[:12]}.parts"
 
 
 def output_lock_path(output) -> Path:

@@ -53,10 +53,11 @@ class RunLock:
     def release(self, remove: bool = False) -> None:
         if self._fd is None:
             return
-        if remove:
-            try:
+        try:
+            if remove:
                 self.path.unlink()
-            except FileNotFoundError:
-                pass
-        os.close(self._fd)
-        self._fd = None
+        except OSError:  # gone, or its folder turned read-only: the lock itself still ends with the descriptor
+            pass
+        finally:
+            os.close(self._fd)
+            self._fd = None

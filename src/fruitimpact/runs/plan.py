@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import json
 import re
 from dataclasses import dataclass
@@ -78,7 +79,10 @@ class Threshold:
         if match is None:
             raise ValueError(f"a threshold is NAME>VALUE (or >=, <, <=), e.g. peak_force>60N; got {text!r}")
         name, op, value = match.groups()
-        return cls(name, op, characteristic(name).parse(value), text.strip())
+        number = characteristic(name).parse(value)
+        if not math.isfinite(number):  # "peak_force>nan" would count nothing and say 0 %
+            raise ValueError(f"a threshold's value must be a finite number; got {value!r}")
+        return cls(name, op, number, text.strip())
 
     def count(self, values: np.ndarray) -> int:
         """How many of ``values`` [SI] are beyond the threshold (NaN never is)."""

@@ -96,9 +96,15 @@ def _with_keys(table):
 
     import pyarrow as pa
 
+    import pyarrow.compute as pc
+
     names = [column_key(name) for name in table.column_names]
-    columns = [column if INPUTS[name].choices is not None else numeric_fast_path(column)
-               for name, column in zip(names, table.columns)]
+    columns = []
+    for name, column in zip(names, table.columns):
+        if INPUTS[name].choices is not None:  # a name; a Parquet column of numbers (model = 1) is read as text
+            columns.append(column if pa.types.is_string(column.type) else pc.cast(column, pa.string()))
+        else:
+            columns.append(numeric_fast_path(column))
     return pa.Table.from_arrays(columns, names=names)
 
 
@@ -142,6 +148,18 @@ class TableSource:
             check_columns(columns)
         except ValueError as exc:
             raise ValueError(f"input {str(path)!r}: {exc}") from None
+        if fmt == "parquet":  # cells are numbers or text: a list or a record cannot be an input
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            for field in pq.ParquetFile(path).schema_arrow:
+                plain = (pa.types.is_integer(field.type) or pa.types.is_floating(field.type)
+                         or pa.types.is_string(field.type) or pa.types.is_large_string(field.type)
+                         or pa.types.is_boolean(field.type) or pa.types.is_null(field.type)
+                         or pa.types.is_dictionary(field.type))
+                if not plain:
+                    raise ValueError(f"input {str(path)!r}: column {field.name!r} holds {field.type} values; an "
+                                     f"input column holds numbers or text")
         stamp = _stamp(path)
         size = stamp[0]
         if fmt == "csv":
@@ -194,7 +212,8 @@ class TableSource:
             yield pa.Table.from_batches([batch]), None
 
     def _csv_pieces(self):
-        """(table, None) runs of well-formed rows and (None, message) for each ragged row, in file order."""
+        """(table, None) runs of well-formed rows and (None, message) for each bad row, in file order: a ragged
+        row (its field count), or a row with a cell that is not UTF-8 text (its cells are not read)."""
         import pyarrow as pa
         import pyarrow.csv as pacsv
 
@@ -206,26 +225,67 @@ class TableSource:
                                            f"{row.expected_columns} (row skipped, its cells not read)"))
             return "skip"
 
+        # cells are read as bytes and checked as UTF-8 batch by batch: one undecodable cell makes its row invalid
+        # instead of stopping the file (pyarrow's own string conversion refuses the whole file at that cell)
         reader = pacsv.open_csv(
             self.path,
             read_options=pacsv.ReadOptions(use_threads=False, block_size=CSV_BLOCK_BYTES),
             parse_options=pacsv.ParseOptions(newlines_in_values=True, invalid_row_handler=skip),
-            convert_options=pacsv.ConvertOptions(column_types={name: pa.string() for name in self.columns},
+            convert_options=pacsv.ConvertOptions(column_types={name: pa.binary() for name in self.columns},
                                                  null_values=[""], strings_can_be_null=True))
         position = 0
         for batch in reader:
+            text, undecodable = _as_text(batch)
             taken = 0
             while taken < batch.num_rows:
-                if ragged and ragged[0][0] == position:
+                if ragged and ragged[0][0] == position:  # a ragged row is not in the batch: it keeps its place
                     yield None, ragged.pop(0)[1]
                     position += 1
                     continue
-                run = batch.num_rows - taken if not ragged else min(batch.num_rows - taken, ragged[0][0] - position)
-                yield pa.Table.from_batches([batch.slice(taken, run)]), None
+                if taken in undecodable:
+                    yield None, (f"row has a cell that is not UTF-8 text (column {undecodable[taken]!r}); its cells "
+                                 f"not read")
+                    taken += 1
+                    position += 1
+                    continue
+                run = batch.num_rows - taken
+                if ragged:
+                    run = min(run, ragged[0][0] - position)
+                later = [row for row in undecodable if row > taken]
+                if later:
+                    run = min(run, min(later) - taken)
+                yield text.slice(taken, run), None
                 taken += run
                 position += run
         for _, message in ragged:
             yield None, message
+
+
+def _as_text(batch):
+    """(table of text columns, {row: column} of the rows with a cell that is not UTF-8) of a batch read as bytes;
+    such a row's cells become null (the row is refused with a message, never read)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    columns, undecodable = [], {}
+    for name, column in zip(batch.schema.names, batch.columns):
+        try:
+            columns.append(pc.cast(column, pa.string()))
+            continue
+        except pa.ArrowInvalid:
+            pass
+        cells = column.to_pylist()
+        for row, cell in enumerate(cells):
+            try:
+                cells[row] = None if cell is None else cell.decode("utf-8")
+            except UnicodeDecodeError:
+                cells[row] = None
+                undecodable.setdefault(row, name)
+        columns.append(pa.array(cells, type=pa.string()))
+    if undecodable:  # every cell of such a row is withheld, not only the bad one
+        keep = pa.array([row not in undecodable for row in range(batch.num_rows)])
+        columns = [pc.if_else(keep, column, pa.nulls(batch.num_rows, pa.string())) for column in columns]
+    return pa.Table.from_arrays(columns, names=batch.schema.names), undecodable
 
 
 def _cut(pieces, chunk_rows: int, schema):
@@ -330,7 +390,10 @@ def parse_axis(name: str, text: str) -> Axis:
         raise ValueError(f"log: needs a range log:START:STOP:COUNT; got {text!r}")
     items = body.split(",")
     check_count("the number of values", len(items), 1, MAX_AXIS_VALUES)
-    return Axis(name, tuple(parse_quantity(v, quantity.dimension) for v in items))
+    values = tuple(parse_quantity(v, quantity.dimension) for v in items)
+    if any(math.isnan(v) for v in values):  # a NaN is never a value to sweep over (a single one is refused too)
+        raise ValueError(f"each value must be a number, not NaN; got {text!r}")
+    return Axis(name, values)
 
 
 @dataclass(frozen=True)

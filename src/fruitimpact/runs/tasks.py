@@ -15,6 +15,8 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
+import numpy as np
+
 from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name,
                                            read_count, spec_text)
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
@@ -53,6 +55,8 @@ def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, work
         raise InputError("engine dask needs dask[distributed]: pip install 'fruitimpact[dask]'", "engine")
     chosen = runs.DaskEngine(scheduler=scheduler, workers=workers) if engine == "dask" else runs.InProcessEngine()
     folder = Path(workdir) if workdir else runs.default_workdir(output, plan)
+    if output is not None and folder.resolve() == Path(output).resolve():
+        raise InputError(f"workdir: cannot use {str(folder)!r}: it is the output file's own name", "workdir")
     existing = folder
     while not existing.exists() and existing != existing.parent:
         existing = existing.parent
@@ -178,6 +182,9 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
     from fruitimpact.runs.sources import Axis, GridSource, parse_axis
 
     chunk_size = read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS)
+    if not axes_text:
+        raise InputError("give at least one input to sweep: a range START:STOP:COUNT, a list or a value (e.g. "
+                         "velocity 0.3:1.5:25)")
     axes, constants, text = [], {}, {}
     for name, spec in axes_text.items():
         try:
@@ -298,9 +305,14 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
             names = characteristics_list(characteristics)
         else:
             names = tuple(characteristic(str(name)).name for name in characteristics)
+            if not names:
+                raise ValueError("give at least one characteristic")
     except ValueError as exc:
         raise InputError(f"characteristics: {exc}", "characteristics") from None
     parsed = []
+    if thresholds is None or not isinstance(thresholds, (str, list, tuple)):
+        raise InputError(f"threshold: thresholds are texts such as 'peak_force>60N', one or a list; got "
+                         f"{thresholds!r}", "threshold")
     for item in [thresholds] if isinstance(thresholds, str) else thresholds:
         try:
             parsed.append(item if isinstance(item, Threshold) else Threshold.parse(str(item)))
@@ -314,8 +326,10 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
 
 def check_percentiles(percentiles) -> tuple[float, ...]:
     """Percentiles [%], each in [0, 100]: a sequence or a comma list ``"5,50,95"``."""
-    items = percentiles.split(",") if isinstance(percentiles, str) else list(percentiles)
     try:
+        items = percentiles.split(",") if isinstance(percentiles, str) else list(percentiles)
+        if any(isinstance(p, (bool, np.bool_)) for p in items):
+            raise TypeError
         values = tuple(float(p) for p in items)
     except (TypeError, ValueError):
         values = (math.nan,)
