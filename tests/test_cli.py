@@ -591,3 +591,26 @@ def test_a_failure_caused_by_a_swallowed_ctrl_c_is_answered_as_the_interrupt(mon
         signal.signal(signal.SIGALRM, saved_alarm)
     out, err = capsys.readouterr()
     assert status == 130 and err == "fruitimpact line: interrupted\n" and out == ""
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["simulate", "--help"], ["simulate", "--mass", "-1"],
+                                  ["drop", "--mass", "0"], ["simulate", "--plot", "figure.bogus"],
+                                  ["population", "-n", "-1"], ["stream", "--rate", "0"],
+                                  ["sweep", "--mass", "1,2", "--plot", "figure.bogus"], ["simulate", "--mas", "1"]])
+def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_numpy(argv, tmp_path):
+    """Issue 15 item 4: ``--help`` and a usage error answer at once (0.25 s), so they may not start numba (0.7 s)
+    or NumPy (0.15 s).  The console script itself is run, as a subprocess: ``main()`` in process shares the
+    test's already imported modules and would prove nothing.  Python's own import log (-X importtime, set by
+    PYTHONPROFILEIMPORTTIME) lists every module the process imported; the timing is in benchmarks/interactive.py."""
+    import os
+    import subprocess
+
+    from conftest import console_script
+
+    env = {**os.environ, "PYTHONPROFILEIMPORTTIME": "1"}
+    done = subprocess.run([console_script(), *argv], capture_output=True, text=True, cwd=tmp_path, env=env,
+                          timeout=60)
+    assert done.returncode == (0 if "--help" in argv else 2), done.stderr[-2000:]
+    imported = {line.rsplit("|", 1)[-1].strip() for line in done.stderr.splitlines() if line.startswith("import time:")}
+    assert "fruitimpact.cli" in imported  # the log is there: the check below can fail
+    assert not {name for name in imported if name.split(".")[0] in ("numba", "numpy")}, argv

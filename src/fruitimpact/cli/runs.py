@@ -95,6 +95,7 @@ def cmd_sweep(args) -> int:
     from fruitimpact.runs import tasks
 
     order = list(getattr(args, "order", None) or [])
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     plan, axes = _library_call(tasks.sweep_plan, {dest: getattr(args, dest) for dest in order}, args.chunk_size)
     try:
         name = runs.characteristic(args.characteristic).name
@@ -105,7 +106,6 @@ def cmd_sweep(args) -> int:
                          + (f" ({', '.join(a.name for a in axes)})" if axes else " (give START:STOP:COUNT)"))
     if not (args.output or args.plot):
         raise UsageError("argument -o/--output: give -o OUT and/or --plot FILE")
-    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     summary = _run(args, plan, keep_columns=(name,) if args.plot else ())
     if summary is None:
         return 130

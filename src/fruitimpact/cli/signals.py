@@ -123,15 +123,16 @@ def cmd_analyze(args) -> int:
     check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
-    from fruitimpact.signals import offline
-    from fruitimpact.signals.analysis import public
     from fruitimpact.signals.read import open_recording
-    from fruitimpact.signals.stream import StreamAnalyzer
 
     try:
         source = open_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
     except ValueError as exc:
         raise UsageError(_reading_error(exc, args)) from None
+    from fruitimpact.signals import offline  # the detector and the fit (numba) once the file opened
+    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.stream import StreamAnalyzer
+
     settings, analysis = analysis_from(args, source.rate)
     keep = bool(args.plot)  # a figure of the recording needs its samples and windows
     impacts, reports = [], []

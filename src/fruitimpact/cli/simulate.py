@@ -87,11 +87,11 @@ def _overlays(args) -> list[dict]:
 
 
 def cmd_simulate(args) -> int:
-    from fruitimpact.impact.simulation import simulate
-
     kwargs = _simulate_kwargs(args)
     overlays = _overlays(args)
     check_outputs(("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
+    from fruitimpact.impact.simulation import simulate  # the engine (numba) only once the options are good
+
     result = _library_call(simulate, **kwargs)
     for warning in result.warnings:
         print(f"{PROG} simulate: warning: {warning}", file=sys.stderr)

@@ -29,7 +29,7 @@ _JIT = dict(cache=True, error_model="numpy")
 
 
 @nb.njit(**_JIT)
-def _classify_row(values, velocity, tolerance):
+def classify_row(values, velocity, tolerance):
     if not (math.isfinite(values[PEAK_FORCE]) and math.isfinite(values[CONTACT_DURATION])
             and math.isfinite(values[MAX_DEFLECTION]) and math.isfinite(values[RESTITUTION])):
         return NOT_FINITE
@@ -50,13 +50,13 @@ def _classify_row(values, velocity, tolerance):
 @nb.njit(parallel=True, **_JIT)
 def _classify_parallel(values, velocity, tolerance, out):
     for i in nb.prange(values.shape[0]):
-        out[i] = _classify_row(values[i], velocity[i], tolerance)
+        out[i] = classify_row(values[i], velocity[i], tolerance)
 
 
 @nb.njit(**_JIT)
 def _classify_serial(values, velocity, tolerance, out):
     for i in range(values.shape[0]):
-        out[i] = _classify_row(values[i], velocity[i], tolerance)
+        out[i] = classify_row(values[i], velocity[i], tolerance)
 
 
 def classify(values: np.ndarray, velocity: np.ndarray, tolerance: float) -> np.ndarray:
@@ -68,4 +68,4 @@ def classify(values: np.ndarray, velocity: np.ndarray, tolerance: float) -> np.n
     return out
 
 
-__all__ = ["COLLAPSED", "ENERGY_CREATED", "NOT_FINITE", "NO_REBOUND", "PHYSICAL", "classify"]
+__all__ = ["COLLAPSED", "ENERGY_CREATED", "NOT_FINITE", "NO_REBOUND", "PHYSICAL", "classify", "classify_row"]

@@ -7,8 +7,9 @@ step, model, calibration, method; plain SI numbers or strings with units)
 and returns, per row, the inputs as used, the contact law, every
 characteristic, a ``status`` (``ok``, ``inaccurate``, ``failed``,
 ``invalid``), a ``message`` and ``warnings``.  A bad row never stops the
-others.  ``simulate()`` is this function on one row: there is one path from
-inputs to results, one validation and one judgement.
+others.  ``simulate()`` is this function on one row: there is one validation
+and one judgement (``impact.single`` answers the rows this path judges ok with
+no warning, to the same bit, and hands it every other row).
 
 The work is vectorised end to end: validation on whole columns, one call of
 the compiled kernels per (model, method) group, messages as integer codes

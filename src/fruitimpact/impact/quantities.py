@@ -284,12 +284,24 @@ def inside(bounds, matrix: np.ndarray, which=None) -> np.ndarray:
     return out
 
 
-#: Bounds of the numeric inputs' allowed and plausible ranges, in ``NUMERIC_INPUTS`` order.
-ALLOWED_BOUNDS = _bounds(INPUTS[name].allowed for name in NUMERIC_INPUTS)
-PLAUSIBLE_BOUNDS = _bounds(INPUTS[name].plausible for name in NUMERIC_INPUTS)
-#: Defaults of the numeric inputs (NaN: none), a column for ``numpy.where``.
-NUMERIC_DEFAULTS = np.array([INPUTS[name].default if INPUTS[name].default is not None else math.nan
-                             for name in NUMERIC_INPUTS])[:, None]
+#: The array forms of the table, built on first use (module ``__getattr__``) so that reading the table, as the
+#: command line's parser does, never imports NumPy (``--help`` and usage errors answer in a tenth of a second):
+#: ``ALLOWED_BOUNDS`` and ``PLAUSIBLE_BOUNDS``, the bounds of the numeric inputs' allowed and plausible ranges in
+#: ``NUMERIC_INPUTS`` order, and ``NUMERIC_DEFAULTS``, their defaults (NaN: none) as a column for ``numpy.where``.
+_ARRAYS = {
+    "ALLOWED_BOUNDS": lambda: _bounds(INPUTS[name].allowed for name in NUMERIC_INPUTS),
+    "PLAUSIBLE_BOUNDS": lambda: _bounds(INPUTS[name].plausible for name in NUMERIC_INPUTS),
+    "NUMERIC_DEFAULTS": lambda: np.array([INPUTS[name].default if INPUTS[name].default is not None else math.nan
+                                          for name in NUMERIC_INPUTS])[:, None],
+}
+
+
+def __getattr__(name: str):
+    build = _ARRAYS.get(name)
+    if build is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = globals()[name] = build()
+    return value
 
 
 #: Outputs of one impact (the characteristics, then the contact law as used).

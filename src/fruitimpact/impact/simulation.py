@@ -10,7 +10,10 @@ Everything is SI; strings with units are accepted too (``Fruit(mass="115g")``).
 ``simulate()`` is ``impact.evaluation.evaluate`` of one row: the same validation (a
 ``ValueError`` with the CLI's message, naming the argument), the same
 kernels and the same judgement of the result (``status``, ``message``,
-``warnings``).
+``warnings``).  The common case (an ok impact with no warning) is answered by
+``impact.single`` without the table's bookkeeping, 30 times faster, with the
+same result to the bit (``tests/test_single.py``); every other call takes the
+table path.
 """
 
 from __future__ import annotations
@@ -30,11 +33,17 @@ from fruitimpact.impact.status import STATUS_NAMES
 from fruitimpact.impact.validation import InputError, check_choice, check_value, read_value
 
 
+_FIELD_NAMES: dict = {}
+
+
 def _unvalidated(cls, values: dict):
-    """An instance of the frozen dataclass ``cls`` whose values were validated by the table already."""
+    """An instance of the frozen dataclass ``cls`` whose values were validated already (by the table, or by
+    ``impact.single``): every field from ``values`` (None where absent), without ``__init__``'s checks."""
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(item.name for item in fields(cls))
     instance = object.__new__(cls)
-    for item in fields(cls):
-        object.__setattr__(instance, item.name, values.get(item.name))
+    instance.__dict__.update({name: values.get(name) for name in names})  # frozen: no __setattr__ per field
     return instance
 
 
@@ -355,7 +364,9 @@ def _row(fruit, surface, keywords: dict) -> dict:
     if isinstance(surface, str):
         keywords = {"surface": surface, **keywords}
     elif isinstance(surface, Surface):
-        row.update({"surface_" + name: [value] for name, value in asdict(surface).items()})
+        # a crush stress of inf is "does not crush", the default: given, it would be refused off a layer
+        row.update({"surface_" + name: [value] for name, value in asdict(surface).items()
+                    if not (name == "crush_stress" and math.isinf(value))})
     elif surface is not None:
         raise InputError(f"surface must be a Surface, a surface of the library (fruitimpact surfaces) or None for "
                          f"a rigid plane; got {surface!r}", "surface")
@@ -451,11 +462,19 @@ def simulate(fruit: Fruit | str | None = None, *, velocity=None, drop_height=Non
     from fruitimpact.impact.validation import check_integer
 
     curve_points = check_integer("curve_points", curve_points, 2, 10_000_000)
+    keywords = dict(velocity=velocity, drop_height=drop_height, restitution=restitution, alpha=alpha,
+                    damping=damping, model=model, calibration=calibration, method=method, step=step, **inputs)
+    from fruitimpact.impact import single
+
+    result = single.impact(fruit, surface, keywords, curve_points)  # the common case, without the table
+    return result if result is not None else _simulate_table(fruit, surface, keywords, curve_points)
+
+
+def _simulate_table(fruit, surface, keywords: dict, curve_points: int) -> ImpactResult:
+    """``simulate`` by the table path (``impact.evaluation``): every row, every message and warning."""
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
 
-    keywords = dict(velocity=velocity, drop_height=drop_height, restitution=restitution, alpha=alpha,
-                    damping=damping, model=model, calibration=calibration, method=method, step=step, **inputs)
     row = _row(fruit, surface, keywords)
     inputs, messages = read_columns(row)
     result = evaluate_inputs(inputs, messages, detail=True, closed_forms=True)

@@ -15,6 +15,7 @@ per distinct message (``MessageBook``) and bit masks of warnings
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -58,13 +59,19 @@ def nan_message(quantity: Quantity) -> str:
             f"None or pd.NA)")
 
 
+def is_boolean(value) -> bool:
+    """True for a Python or a NumPy boolean.  NumPy is consulted only for its own objects, so that validating
+    the command line's options never imports it (``numbers.Real`` covers NumPy's numbers the same way)."""
+    return isinstance(value, bool) or (type(value).__module__ == "numpy" and isinstance(value, np.bool_))
+
+
 def read_value(name: str, value) -> float:
     """``value`` of input ``name`` as a float [SI]: numbers as they are, strings with
     units parsed (``"115g"``).  ``InputError`` if it is not a number."""
     quantity = INPUTS[name]
     if isinstance(value, bool):
         raise InputError(unreadable_message(quantity, value), name)
-    if isinstance(value, (int, float, np.integer, np.floating)):
+    if isinstance(value, numbers.Real):
         return float(value)
     if isinstance(value, str):
         try:
@@ -103,7 +110,7 @@ def check_number(name: str, value, *, owner: str = "", low=None, low_inclusive: 
     if value is None and optional:
         return None
     label = f"{owner}.{name}" if owner else name
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+    if is_boolean(value) or not isinstance(value, numbers.Real):
         raise InputError(f"{label} must be a number; got {value!r}", name)
     value = float(value)
     ok = math.isfinite(value)
@@ -125,7 +132,7 @@ def check_number(name: str, value, *, owner: str = "", low=None, low_inclusive: 
 def check_integer(name: str, value, low: int, high: int | None = None, *, owner: str = "") -> int:
     """An integer in [low, high] (``high`` None: no upper bound), else ``InputError`` naming ``name``."""
     label = f"{owner}.{name}" if owner else name
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low \
+    if is_boolean(value) or not isinstance(value, numbers.Integral) or value < low \
             or (high is not None and value > high):
         allowed = f"in [{low}, {high}]" if high is not None else f">= {low}"
         raise InputError(f"{label} must be an integer {allowed}; got {value!r}", name)
@@ -135,7 +142,7 @@ def check_integer(name: str, value, low: int, high: int | None = None, *, owner:
 def check_flag(name: str, value) -> bool:
     """``value`` if it is True or False (a numpy bool too), else ``InputError`` naming ``name``: a text such as
     ``"no"`` is truthy and would do the opposite of what was meant."""
-    if not isinstance(value, (bool, np.bool_)):
+    if not is_boolean(value):
         raise InputError(f"{name} must be True or False; got {value!r}", name)
     return bool(value)
 
@@ -154,7 +161,7 @@ def spec_text(name: str, value) -> str:
     def scalar(item) -> str:
         if isinstance(item, str):
             return item
-        if isinstance(item, (bool, np.bool_)) or not isinstance(item, (int, float, np.integer, np.floating)):
+        if is_boolean(item) or not isinstance(item, numbers.Real):
             raise TypeError  # True is not 1.0; a nested list is not a value
         return repr(float(item))
 
@@ -189,7 +196,7 @@ def read_count(name: str, value, low: int, high: int | None = None) -> int:
 
     allowed = f">= {low:,}" if high is None else f"in [{low:,}, {high:,}]"
     number = None
-    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+    if isinstance(value, numbers.Integral) and not is_boolean(value):
         number = decimal.Decimal(int(value))
     elif isinstance(value, str):
         try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import math
 import json
+import operator
 import re
 from dataclasses import dataclass
 
@@ -60,7 +61,7 @@ def characteristics_list(text: str) -> tuple[str, ...]:
     return names
 
 
-_OPERATORS = {">=": np.greater_equal, "<=": np.less_equal, ">": np.greater, "<": np.less}
+_OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}  # elementwise on arrays
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name,
+from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name, is_boolean,
                                            read_count, spec_text)
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
                                    Plan, Threshold, characteristic, characteristics_list)
@@ -328,7 +328,7 @@ def check_percentiles(percentiles) -> tuple[float, ...]:
     """Percentiles [%], each in [0, 100]: a sequence or a comma list ``"5,50,95"``."""
     try:
         items = percentiles.split(",") if isinstance(percentiles, str) else list(percentiles)
-        if any(isinstance(p, (bool, np.bool_)) for p in items):
+        if any(is_boolean(p) for p in items):
             raise TypeError
         values = tuple(float(p) for p in items)
     except (TypeError, ValueError):

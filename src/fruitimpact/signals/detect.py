@@ -71,6 +71,7 @@ for the indices (``signals.indices``) and a model fit.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numba as nb
@@ -556,7 +557,7 @@ class Detector:
         rate = check_rate(rate)
         if rate is None:
             raise ValueError("rate must be a finite number of Hz > 0; got None")
-        if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= 1024:
+        if isinstance(lanes, bool) or not isinstance(lanes, numbers.Integral) or not 1 <= lanes <= 1024:
             raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
         if settings is None:
             settings = DetectorSettings()

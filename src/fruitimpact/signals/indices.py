@@ -43,6 +43,7 @@ truncated impact or a pulse below ~5σ) is NaN; the onset then falls back to the
 from __future__ import annotations
 
 import math
+import numbers
 
 import numba as nb
 import numpy as np
@@ -264,7 +265,7 @@ def impact_indices(impact: DetectedImpact, rate: float) -> dict:
     """
     if not isinstance(impact, DetectedImpact):
         raise ValueError(f"impact must be a DetectedImpact; got {type(impact).__name__}")  # noqa: TRY004
-    if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)) \
+    if isinstance(rate, bool) or not isinstance(rate, numbers.Real) \
             or not math.isfinite(float(rate)) or not float(rate) > 0:
         raise ValueError(f"rate must be a finite number of Hz in (0, inf); got {rate!r}")
     rate = float(rate)

@@ -9,17 +9,18 @@ read-only mapping.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
 
-from fruitimpact.impact.validation import InputError
+from fruitimpact.impact.validation import InputError, is_boolean
 
 
 def _finite_number(name: str, value, *, positive: bool = False) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+    if is_boolean(value) or not isinstance(value, numbers.Real):
         raise InputError(f"{name} must be a number; got {value!r}", name)
     value = float(value)
     if not math.isfinite(value) or (positive and value <= 0.0):

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import itertools
 import math
+import numbers
 from dataclasses import dataclass
 
-import numpy as np
 
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import InputError, check_number
+from fruitimpact.impact.validation import InputError, check_number, is_boolean
 
 __all__ = ["DetectorSettings"]
 
@@ -97,11 +97,11 @@ class DetectorSettings:
         if self.clip_low is not None and self.clip_high is not None and not self.clip_low < self.clip_high:
             raise ValueError(f"clip_high must be > clip_low = {self.clip_low}; got {self.clip_high!r}")
         order = self.lowpass_order
-        if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 8:
+        if isinstance(order, bool) or not isinstance(order, numbers.Integral) or not 1 <= order <= 8:
             raise ValueError(f"lowpass_order must be an integer in [1, 8]; got {order!r}")
         harmonics = self.hum_harmonics
         if (not isinstance(harmonics, (tuple, list)) or not 1 <= len(harmonics) <= 4
-                or any(isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= 16
+                or any(isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 1 <= k <= 16
                        for k in harmonics)
                 or any(b <= a for a, b in itertools.pairwise(harmonics))):
             raise ValueError(f"hum_harmonics must be 1 to 4 ascending integers in [1, 16]; got {harmonics!r}")
@@ -124,7 +124,7 @@ def check_rate(rate, argument: str = "rate") -> float | None:
         except ValueError:
             raise InputError(f"{argument} must be a sample rate (a number of Hz, or with a unit: 20kHz); got "
                              f"{rate!r}", argument) from None
-    if isinstance(rate, (bool, np.bool_)) or not isinstance(rate, (int, float, np.integer, np.floating)):
+    if is_boolean(rate) or not isinstance(rate, numbers.Real):
         raise InputError(f"{argument} must be a number of samples per second [Hz] > 0; got {rate!r}", argument)
     rate = float(rate)
     if not math.isfinite(rate) or not 0.0 < rate <= MAX_RATE:

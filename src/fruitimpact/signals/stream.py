@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import signal
 import socket
 import sys
@@ -50,7 +51,7 @@ def _default_problem(message: str) -> None:
 
 
 def _lanes(lanes) -> int:
-    if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= 1024:
+    if isinstance(lanes, bool) or not isinstance(lanes, numbers.Integral) or not 1 <= lanes <= 1024:
         raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
     return int(lanes)
 
@@ -430,7 +431,7 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
     client.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
     the socket is opened.
     """
-    if isinstance(port, bool) or not isinstance(port, (int, np.integer)) or not 0 <= port <= 65535:
+    if isinstance(port, bool) or not isinstance(port, numbers.Integral) or not 0 <= port <= 65535:
         raise ValueError(f"port must be an integer in [0, 65535]; got {port!r}")
     if max_clients is not None and (isinstance(max_clients, bool) or not isinstance(max_clients, (int, np.integer))
                                     or max_clients < 1):
