@@ -225,7 +225,7 @@ def test_population_agrees_with_the_cli(cli, tmp_path, monkeypatch):
 ])
 def test_the_run_functions_refuse_what_the_commands_refuse(cli, tmp_path, monkeypatch, argv, call):
     """One path: the function's ValueError is the command's line, with the option in place of the argument."""
-    from fruitimpact.cli.common import usage_message
+    from fruitimpact.impact.validation import usage_message
 
     import tempfile
 

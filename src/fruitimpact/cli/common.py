@@ -13,9 +13,9 @@ import math
 import re
 import sys
 
-from fruitimpact.impact.quantities import INPUTS, option_of
+from fruitimpact.impact.quantities import INPUTS
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import check_choice, check_value, conflict_message
+from fruitimpact.impact.validation import check_choice, check_value, usage_message
 
 from fruitimpact.cli import PROG  # noqa: E402,F401  (defined by the package first; the commands import it from here)
 
@@ -62,27 +62,6 @@ def _quantities(args, options=IMPACT_OPTIONS) -> dict:
     return values
 
 
-def usage_message(exc: ValueError) -> str:
-    """A library error as the CLI's line: the option named from the error's argument (a message that starts
-    with the argument's own name and a colon, ``workdir: ...``, names it once)."""
-    argument = getattr(exc, "argument", None)
-    if isinstance(argument, tuple):  # a conflict between inputs given together
-        return conflict_message([option_of(name) for name in argument])
-    if isinstance(argument, str) and (argument in INPUTS or argument in COMMAND_ARGUMENTS):
-        text = str(exc)
-        text = text[len(argument) + 2:] if text.startswith(argument + ": ") else text
-        return f"argument {COMMAND_ARGUMENTS.get(argument) or option_of(argument)}: {text}"
-    return str(exc)
-
-
-#: Library arguments of the commands that are not table inputs, and their CLI options (``drop``'s
-#: ``bounces``, ``line``'s ``alternatives``, the run options of ``batch``, ``sweep`` and ``population``).
-COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "alternatives": "--alternatives",
-                     "rows": "-n/--rows", "seed": "--seed", "chunk_size": "--chunk-size", "workers": "--workers",
-                     "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
-                     "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
-                     "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size",
-                     "rate": "--rate"}
 
 
 def check_outputs(*outputs) -> None:

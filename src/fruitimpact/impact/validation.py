@@ -19,7 +19,7 @@ import numbers
 
 import numpy as np
 
-from fruitimpact.impact.quantities import INPUTS, Quantity, Range
+from fruitimpact.impact.quantities import INPUTS, Quantity, Range, option_of
 from fruitimpact.impact.units import UNITS, parse_quantity
 
 
@@ -301,7 +301,31 @@ def implausible_message(quantity: Quantity, value: float | None = None) -> str:
             f"[{plausible.low:g}, {plausible.high:g}]{unit}{plain}")
 
 
+def usage_message(exc: ValueError) -> str:
+    """A library error as the CLI's line, and the web app's next to its control: the option named from the
+    error's argument (a message that starts with the argument's own name and a colon, ``workdir: ...``, names it
+    once)."""
+    argument = getattr(exc, "argument", None)
+    if isinstance(argument, tuple):  # a conflict between inputs given together
+        return conflict_message([option_of(name) for name in argument])
+    if isinstance(argument, str) and (argument in INPUTS or argument in COMMAND_ARGUMENTS):
+        text = str(exc)
+        text = text[len(argument) + 2:] if text.startswith(argument + ": ") else text
+        return f"argument {COMMAND_ARGUMENTS.get(argument) or option_of(argument)}: {text}"
+    return str(exc)
+
+
+#: Library arguments of the commands that are not table inputs, and their CLI options (``drop``'s
+#: ``bounces``, ``line``'s ``alternatives``, the run options of ``batch``, ``sweep`` and ``population``).
+COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "alternatives": "--alternatives",
+                     "rows": "-n/--rows", "seed": "--seed", "chunk_size": "--chunk-size", "workers": "--workers",
+                     "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
+                     "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
+                     "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size",
+                     "rate": "--rate"}
+
+
 __all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag",
            "check_input_name", "spec_text", "check_value", "conflict_message",
            "implausible_message", "nan_message", "range_message", "read_count", "read_value",
-           "unreadable_message"]
+           "unreadable_message", "COMMAND_ARGUMENTS", "usage_message", "is_boolean"]
