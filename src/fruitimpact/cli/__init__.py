@@ -15,12 +15,12 @@ import sys
 
 PROG = "fruitimpact"
 COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population", "drop", "safe-height", "line", "fruits",
-            "surfaces", "analyze", "classes", "stream", "synth")
+            "surfaces", "analyze", "classes", "stream", "synth", "serve")
 
 
 def build_parser():
     """The argparse parser of every command (built from the table of quantities)."""
-    from fruitimpact.cli import damage, reference, runs, signals, simulate
+    from fruitimpact.cli import app, damage, reference, runs, signals, simulate
     from fruitimpact.cli.common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
@@ -30,6 +30,7 @@ def build_parser():
     runs.add_parsers(sub)
     damage.add_parsers(sub)
     signals.add_parsers(sub)
+    app.add_parsers(sub)
     return parser
 
 

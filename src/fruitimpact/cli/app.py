@@ -1,0 +1,47 @@
+"""``fruitimpact serve``: the web app (issue 16), an optional extra."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+
+from fruitimpact.cli.common import PROG, UsageError
+
+#: The port the app listens on by default.
+DEFAULT_PORT = 8050
+
+
+def add_parsers(sub) -> None:
+    serve = sub.add_parser("serve", help="the web app: explore an impact in a browser",
+                           description="Start the web app on this machine and print its address. It listens on "
+                                       "127.0.0.1 (this machine only) unless --host is given.")
+    serve.add_argument("--port", default=str(DEFAULT_PORT), metavar="P",
+                       help=f"TCP port, 0 to 65535 (0: a free one; default {DEFAULT_PORT})")
+    serve.add_argument("--host", default="127.0.0.1", metavar="H",
+                       help="address to listen on (default 127.0.0.1; another address lets anyone on that "
+                            "network use the app)")
+    serve.set_defaults(func=cmd_serve)
+
+
+def cmd_serve(args) -> int:
+    port = args.port
+    if not (str(port).isdigit() and 0 <= int(port) <= 65535):
+        raise UsageError(f"argument --port: must be an integer in [0, 65535]; got {port!r}")
+    if importlib.util.find_spec("tornado") is None:
+        raise UsageError("the web app needs tornado: pip install 'fruitimpact[app]'")
+    from fruitimpact.app import server
+
+    host = args.host
+    if not server.is_loopback(host):
+        print(f"{PROG} serve: warning: listening on {host}: anyone on that network can use this app "
+              f"(it has no login)", file=sys.stderr)
+
+    def ready(bound_host, bound_port):
+        shown = f"[{bound_host}]" if ":" in bound_host else bound_host
+        print(f"{PROG} serve: http://{shown}:{bound_port}/ (Ctrl-C to stop)", flush=True)
+
+    try:
+        server.serve(host, int(port), ready)
+    except OSError as error:  # the port taken, an address not on this machine
+        raise UsageError(f"argument --port: cannot listen on {host}:{port}: {error.strerror or error}") from None
+    return 0
