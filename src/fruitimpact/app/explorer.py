@@ -174,10 +174,8 @@ def options() -> dict:
     controls = {}
     for name in EXPLORER_INPUTS:
         quantity = INPUTS[name]
-        default = quantity.default
         controls[name] = {"label": quantity.label, "option": option_of(name), "unit": quantity.si_unit,
-                          "default": default if not isinstance(default, float) or math.isfinite(default) else None,
-                          "doc": quantity.doc}
+                          "default": quantity.default, "doc": quantity.doc}  # inf is null in the JSON
     return {
         "fruits": [{"name": name, "description": entry.description} for name, entry in catalogue.fruits().items()],
         "surfaces": [{"name": "rigid", "description": "a rigid plane (the founding paper's)"}]

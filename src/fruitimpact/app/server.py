@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import math
 import socket
 import sys
 import traceback
@@ -25,6 +24,7 @@ import tornado.netutil
 import tornado.web
 
 from fruitimpact.app import explorer
+from fruitimpact.impact.outputs import dump_json
 from fruitimpact.impact.validation import usage_message
 
 #: Largest JSON request body [bytes] (the explorer's are a few hundred); up to ``MAX_BODY`` one is answered 413,
@@ -40,16 +40,6 @@ PAGES = {"/": ("Explorer", "explorer.html")}
 
 def _static() -> str:
     return str(resources.files("fruitimpact.app") / "static")
-
-
-def _json_safe(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    return value
 
 
 class _Secure:
@@ -76,19 +66,20 @@ class StaticHandler(_Secure, tornado.web.StaticFileHandler):
 class ApiHandler(_Secure, tornado.web.RequestHandler):
     """A JSON call: the body is a JSON object, the answer a JSON object; errors as described in the module."""
 
-    def initialize(self, compute):
+    def initialize(self, compute, method: str = "POST"):
         self.compute = compute
+        self.SUPPORTED_METHODS = (method,)  # the other answered 405 by tornado (as JSON: write_error)
 
     def _answer(self, status: int, body: dict) -> None:
         self.set_status(status)
         self.set_header("Content-Type", "application/json; charset=utf-8")
         self.set_header("Cache-Control", "no-store")
-        self.finish(json.dumps(_json_safe(body), allow_nan=False))
+        self.finish(dump_json(body, indent=None))
 
     def write_error(self, status_code: int, **kwargs):  # tornado's own errors (a bad method...), as JSON
         self._answer(status_code, {"error": self._reason})
 
-    async def get(self):
+    async def get(self):  # a route without inputs (the options)
         await self._run(None)
 
     async def post(self):
@@ -123,7 +114,7 @@ def make_app() -> tornado.web.Application:
     """The tornado application: the pages, ``/static/``, and the JSON API under ``/api/``."""
     routes = [(path, PageHandler, {"page": page}) for path, (_, page) in PAGES.items()]
     routes += [
-        (r"/api/options", ApiHandler, {"compute": explorer.options}),
+        (r"/api/options", ApiHandler, {"compute": explorer.options, "method": "GET"}),
         (r"/api/explore", ApiHandler, {"compute": explorer.explore}),
         (r"/api/risk", ApiHandler, {"compute": explorer.risk}),
         (r"/static/(.*)", StaticHandler, {"path": _static()}),
@@ -154,8 +145,6 @@ async def _serve(host: str, port: int, ready) -> None:
 def serve(host: str = "127.0.0.1", port: int = 8050, ready=None) -> None:
     """Run the web app until interrupted; ``ready(host, port)`` is called once it listens (the port is the one
     bound: ``port=0`` picks a free one)."""
-    import tornado.netutil  # noqa: F401 - bind_sockets
-
     asyncio.run(_serve(host, port, ready or (lambda h, p: None)))
 
 

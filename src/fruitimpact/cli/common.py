@@ -8,12 +8,12 @@ allowed range, exit status 2, never a traceback.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import re
 import sys
 
 from fruitimpact.impact.quantities import INPUTS
+from fruitimpact.impact.outputs import dump_json  # noqa: F401  (the commands import it from here)
 from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import check_choice, check_value, usage_message
 
@@ -122,30 +122,6 @@ def _simulate_kwargs(args) -> dict:
     """``simulate()`` keywords from the given options, as typed (the library reads the units):
     every input by its name, ``fruit`` and ``surface`` as library names."""
     return {name: getattr(args, name) for name in INPUTS if getattr(args, name, None) is not None}
-
-
-def _json_default(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return str(value)
-
-
-def _finite(obj):
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_finite(v) for v in obj]
-    return obj
-
-
-def dump_json(obj, indent: int | None = 2) -> str:
-    """JSON with NaN/inf written as null (strict JSON); ``indent=None``: one compact line."""
-    separators = None if indent is not None else (",", ":")
-    return json.dumps(_finite(obj), indent=indent, separators=separators, default=_json_default, allow_nan=False,
-                      ensure_ascii=indent is not None)
-
 
 
 def _float_list(option: str, text: str, low: float, high: float, high_inclusive: bool) -> list[float]:

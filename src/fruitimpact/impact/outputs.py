@@ -18,6 +18,8 @@ outputs) goes through this module:
 from __future__ import annotations
 
 import errno
+import json
+import math
 import os
 import re
 import uuid
@@ -222,6 +224,30 @@ def remove_stale_temporaries(path) -> int:
     return removed
 
 
-__all__ = ["CSV_FORMAT", "FIGURE_FORMATS", "TABLE_FORMATS", "atomic_write", "check_folder", "check_output",
+def _json_default(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return str(value)
+
+
+def _finite(obj):
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def dump_json(obj, indent: int | None = 2) -> str:
+    """Strict JSON of ``obj`` (the CLI's ``--json``, the web app's answers): NaN and infinity written as null,
+    anything else not JSON by its text; ``indent=None``: one compact line."""
+    separators = None if indent is not None else (",", ":")
+    return json.dumps(_finite(obj), indent=indent, separators=separators, default=_json_default, allow_nan=False,
+                      ensure_ascii=indent is not None)
+
+
+__all__ = ["CSV_FORMAT", "FIGURE_FORMATS", "TABLE_FORMATS", "atomic_write", "check_folder", "check_output", "dump_json",
            "check_output_folder",
            "output_error", "output_format", "remove_stale_temporaries", "stale_temporaries", "temporary_path"]

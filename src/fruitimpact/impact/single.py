@@ -193,7 +193,7 @@ def impact(fruit, surface, keywords: dict, curve_points: int):
     # physics.hertz's formulas, in the table's order of operations (the same bits)
     radius = 1.0 / (1.0 / (used["diameter"] / 2.0) + 1.0 / used["surface_radius"])
     modulus, poisson = used["modulus"], used["poisson"]
-    fruit_modulus = 1.0 / ((1.0 - poisson * poisson) / modulus + (1.0 - 0.0 * 0.0) / math.inf)
+    fruit_modulus = 1.0 / ((1.0 - poisson * poisson) / modulus)  # on a rigid surface (its term is 0)
     surface_modulus, surface_poisson = used["surface_modulus"], used["surface_poisson"]
     pair_modulus = 1.0 / ((1.0 - poisson * poisson) / modulus
                           + (1.0 - surface_poisson * surface_poisson) / surface_modulus)
