@@ -614,3 +614,16 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
     imported = {line.rsplit("|", 1)[-1].strip() for line in done.stderr.splitlines() if line.startswith("import time:")}
     assert "fruitimpact.cli" in imported  # the log is there: the check below can fail
     assert not {name for name in imported if name.split(".")[0] in ("numba", "numpy")}, argv
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["serve", "--port", "²"], "argument --port: port must be an integer in [0, 65,535]; got '²'"),
+    (["serve", "--port", "70000"], "argument --port: port must be an integer in [0, 65,535]; got '70000'"),
+    (["synth", "--count", "³", "-o", "x.csv"], "argument --count: count must be an integer in [1, 100,000]; got '³'"),
+    (["stream", "--rate", "1000", "--lanes", "²"], "argument --lanes: lanes must be an integer in [1, 256]; got '²'"),
+    (["analyze", "x.csv", "--lanes", "0"], "argument --lanes: lanes must be an integer >= 1; got '0'")])
+def test_integer_options_are_read_as_integers(argv, line, script, tmp_path):
+    """A superscript is a digit to str.isdigit but not to int(): it gave a traceback (exit 1), now the option's
+    one line (exit 2), like every other count (impact.validation.read_count)."""
+    done = script(*argv, cwd=tmp_path)
+    assert done.returncode == 2 and done.stderr.strip().endswith(line), done.stderr

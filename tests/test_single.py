@@ -139,3 +139,9 @@ def test_a_surface_object_is_simulated():
     # Hertz: a softer surface lowers E*, hence k_c (Johnson 1985 eq 4.22–4.23), below the rigid plane's
     assert result.inputs.surface.modulus == 2e9
     assert result.law.stiffness < fi.simulate().law.stiffness
+
+
+def test_a_numpy_boolean_is_not_a_number():
+    """np.True_ was read as 1.0 (read_value tested for Python's bool only): refused as True is."""
+    with pytest.raises(ValueError, match="restitution must be a number"):
+        fi.simulate(restitution=np.True_)

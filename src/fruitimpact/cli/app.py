@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.util
 import sys
 
-from fruitimpact.cli.common import PROG, UsageError
+from fruitimpact.cli.common import PROG, UsageError, read_option_count
 
 #: The port the app listens on by default.
 DEFAULT_PORT = 8050
@@ -24,9 +24,7 @@ def add_parsers(sub) -> None:
 
 
 def cmd_serve(args) -> int:
-    port = args.port
-    if not (str(port).isdigit() and 0 <= int(port) <= 65535):
-        raise UsageError(f"argument --port: must be an integer in [0, 65535]; got {port!r}")
+    port = read_option_count("--port", args.port, 0, 65535)
     if importlib.util.find_spec("tornado") is None:
         raise UsageError("the web app needs tornado: pip install 'fruitimpact[app]'")
     from fruitimpact.app import server
@@ -41,7 +39,7 @@ def cmd_serve(args) -> int:
         print(f"{PROG} serve: http://{shown}:{bound_port}/ (Ctrl-C to stop)", flush=True)
 
     try:
-        server.serve(host, int(port), ready)
+        server.serve(host, port, ready)
     except OSError as error:  # the port taken, an address not on this machine
         raise UsageError(f"argument --port: cannot listen on {host}:{port}: {error.strerror or error}") from None
     return 0

@@ -39,31 +39,6 @@ def _help(quantity) -> str:
     return f"{quantity.doc}{unit}"
 
 
-#: (option, dimension, help) of the numeric impact inputs, from the table of quantities;
-#: option names are a contract.
-IMPACT_OPTIONS = tuple((q.option, q.dimension, _help(q)) for q in INPUTS.values() if q.numeric and q.option)
-
-
-def _dest(option: str) -> str:
-    return option.lstrip("-").replace("-", "_")
-
-
-def _quantities(args, options=IMPACT_OPTIONS) -> dict:
-    """Parse the unit-bearing options; a bad one raises UsageError naming it."""
-    values = {}
-    for option, dimension, _ in options:
-        text = getattr(args, _dest(option), None)
-        if text is None:
-            continue
-        try:
-            values[_dest(option)] = parse_quantity(text, dimension)
-        except ValueError as exc:
-            raise UsageError(f"argument {option}: {exc}") from None
-    return values
-
-
-
-
 def check_outputs(*outputs) -> None:
     """Each ``(option, path, formats)`` whose path is given: a file that can be written, of one of ``formats``
     (``impact.outputs.check_output``), before any work; a figure (``FIGURE_FORMATS``) also needs matplotlib."""
@@ -77,6 +52,17 @@ def check_outputs(*outputs) -> None:
         _library_call(check_output, path, option, formats)
         if formats is FIGURE_FORMATS and importlib.util.find_spec("matplotlib") is None:
             raise UsageError(f"argument {option}: figures need matplotlib: pip install 'fruitimpact[plot]'")
+
+
+def read_option_count(option: str, value, low: int, high: int | None = None) -> int:
+    """An integer option (``--port``, ``--lanes``, ``--count`` …) read by ``impact.validation.read_count``:
+    ``UsageError`` naming the option and its range otherwise (``str.isdigit`` took ``²`` for a digit)."""
+    from fruitimpact.impact.validation import read_count
+
+    try:
+        return read_count(option.split("/")[-1].lstrip("-").replace("-", "_"), value, low, high)
+    except ValueError as exc:
+        raise UsageError(f"argument {option}: {exc}") from None
 
 
 def _library_call(func, *args, **kwargs):
@@ -138,13 +124,6 @@ def _float_list(option: str, text: str, low: float, high: float, high_inclusive:
         values.append(value)
     return values
 
-
-
-#: Numeric inputs of sweep and population: (option, column, dimension); text inputs: (option, column).
-RUN_NUMERIC = tuple((option, _dest(option), dimension) for option, dimension, _ in IMPACT_OPTIONS)
-RUN_TEXT = tuple((q.option, q.name) for q in INPUTS.values() if not q.numeric)
-#: Inputs whose range depends on other inputs: not checked alone when constant.
-_DEPENDENT_INPUTS = ("alpha", "step")
 
 
 class _Ordered(argparse.Action):

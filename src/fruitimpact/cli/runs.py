@@ -23,7 +23,7 @@ def _run_inputs():
 
 def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> None:
     from fruitimpact.runs import CHUNK_ROWS, ENGINES, MAX_CHUNK_ROWS
-    from fruitimpact.runs.tasks import MAX_WORKERS
+    from fruitimpact.runs.tasks import DEFAULT_WORKERS, MAX_WORKERS
 
     group = parser.add_argument_group("run (chunks, resume, engines)")
     group.add_argument("-o", "--output", metavar="OUT", required=output_required,
@@ -35,8 +35,8 @@ def _add_run_options(parser: argparse.ArgumentParser, output_required: bool) -> 
                        help="inprocess (default) or dask (a LocalCluster of --workers processes, or --scheduler)")
     group.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 "
                                                               "(implies --engine dask)")
-    group.add_argument("--workers", default="2", metavar="N", help=f"worker processes of the local Dask cluster, "
-                                                                  f"1 to {MAX_WORKERS} (default 2; one thread each)")
+    group.add_argument("--workers", default=str(DEFAULT_WORKERS), metavar="N", help=f"worker processes of the local Dask cluster, "
+                                                                  f"1 to {MAX_WORKERS} (default {DEFAULT_WORKERS}; one thread each)")
     group.add_argument("--workdir", metavar="DIR", help="work folder of the part files (default OUT.parts); a new "
                                                         "or empty folder, or one fruitimpact made")
     group.add_argument("--fresh", action="store_true",

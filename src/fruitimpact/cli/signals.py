@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json
+from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json, read_option_count
 from fruitimpact.impact.validation import conflict_message
 from fruitimpact.impact.outputs import FIGURE_FORMATS
 
@@ -117,9 +117,7 @@ class _Progress:
 
 def cmd_analyze(args) -> int:
     rate = _rate(args.rate)
-    lanes = int(args.lanes) if str(args.lanes).isdigit() and int(args.lanes) >= 1 else None
-    if lanes is None:
-        raise UsageError(f"argument --lanes: must be an integer >= 1; got {args.lanes!r}")
+    lanes = read_option_count("--lanes", args.lanes, 1)
     check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
@@ -289,12 +287,8 @@ def cmd_synth(args) -> int:
 
     fmt = _library_call(reading.recording_format, args.output, args.format, "--format")
     check_outputs(("-o/--output", args.output, None if args.format else dict(reading.EXTENSIONS)))
-    count = args.count
-    if not (str(count).isdigit() and 1 <= int(count) <= 100_000):
-        raise UsageError(f"argument --count: must be an integer in [1, 100000]; got {count!r}")
-    lanes = args.lanes
-    if not (str(lanes).isdigit() and 1 <= int(lanes) <= 64):
-        raise UsageError(f"argument --lanes: must be an integer in [1, 64]; got {lanes!r}")
+    count = read_option_count("--count", args.count, 1, 100_000)
+    lanes = read_option_count("--lanes", args.lanes, 1, 64)
     rebounds = args.rebounds
     if rebounds not in ("0", "1", "2"):
         raise UsageError(f"argument --rebounds: must be 0, 1 or 2; got {rebounds!r}")
@@ -312,12 +306,12 @@ def cmd_synth(args) -> int:
         drift=_float("--drift", args.drift, "dimensionless", low=-math.inf),
         hum_amplitude=_float("--hum", args.hum, "force", low_inclusive=True),
         hum_frequency=_float("--hum-frequency", args.hum_frequency, "frequency"),
-        adc_bits=int(args.adc_bits) if str(args.adc_bits).isdigit() else -1,
+        adc_bits=int(args.adc_bits) if str(args.adc_bits).isdecimal() else -1,  # the model refuses -1, naming it
         clip_low=clip[0], clip_high=clip[1],
         plate_frequency=_float("--plate-frequency", args.plate_frequency, "frequency", low_inclusive=True),
         plate_damping=_float("--plate-damping", args.plate_damping, "dimensionless") if args.plate_damping else None,
         antialias_cutoff=_float("--antialias", args.antialias, "frequency", low_inclusive=True),
-        seed=int(args.seed) if str(args.seed).isdigit() else -1)
+        seed=int(args.seed) if str(args.seed).isdecimal() else -1)
     sensor = _library_call(SensorModel, **sensor_kwargs)
     height = _float("--drop-height", args.drop_height, "length", high=10.0) if args.drop_height is not None else None
     population = _library_call(
@@ -390,17 +384,13 @@ def cmd_stream(args) -> int:
     rate = _rate(args.rate)
     if rate is None:
         raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
-    if not (str(args.lanes).isdigit() and 1 <= int(args.lanes) <= 256):
-        raise UsageError(f"argument --lanes: must be an integer in [1, 256]; got {args.lanes!r}")
-    lanes = int(args.lanes)
+    lanes = read_option_count("--lanes", args.lanes, 1, 256)
     source = {"text": "text", "f32": "float32"}.get(args.format)
     if source is None:
         raise UsageError(f"argument --format: must be text or f32; got {args.format!r}")
     port = None
     if args.listen is not None:
-        if not (str(args.listen).isdigit() and 0 <= int(args.listen) <= 65535):
-            raise UsageError(f"argument --listen: must be a port in [0, 65535]; got {args.listen!r}")
-        port = int(args.listen)
+        port = read_option_count("--listen", args.listen, 0, 65535)
     settings, analysis = analysis_from(args, rate)  # plain checks first: a usage error imports no numba
     from fruitimpact.signals.analysis import public
     from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve

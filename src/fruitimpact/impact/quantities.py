@@ -367,14 +367,6 @@ CHARACTERISTICS = OUTPUTS
 DEFAULT_SUMMARY = CHARACTERISTIC_NAMES
 
 
-def input_quantity(name: str) -> Quantity:
-    """The input called ``name`` (``-`` read as ``_``); ``ValueError`` naming the known ones."""
-    key = str(name).strip().replace("-", "_")
-    if key not in INPUTS:
-        raise ValueError(f"unknown input {name!r} (inputs: {', '.join(INPUTS)})")
-    return INPUTS[key]
-
-
 def option_of(name: str) -> str:
     """The CLI option of input ``name`` (``drop_height`` → ``--drop-height``)."""
     quantity = INPUTS.get(name)
@@ -383,4 +375,4 @@ def option_of(name: str) -> str:
 
 __all__ = ["DAMAGE_NAMES", "ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
            "GROUP_DEFAULTS", "INPUTS", "NON_NEGATIVE", "NUMERIC_DEFAULTS", "PLAUSIBLE_BOUNDS", "inside", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
-           "Range", "TEXT_INPUTS", "input_quantity", "option_of"]
+           "Range", "TEXT_INPUTS", "option_of"]

@@ -69,7 +69,7 @@ def read_value(name: str, value) -> float:
     """``value`` of input ``name`` as a float [SI]: numbers as they are, strings with
     units parsed (``"115g"``).  ``InputError`` if it is not a number."""
     quantity = INPUTS[name]
-    if isinstance(value, bool):
+    if is_boolean(value):  # True is not 1.0
         raise InputError(unreadable_message(quantity, value), name)
     if isinstance(value, numbers.Real):
         return float(value)

@@ -15,7 +15,6 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-import numpy as np
 
 from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name, is_boolean,
                                            read_count, spec_text)
@@ -24,13 +23,15 @@ from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAM
 
 #: Most worker processes of a local Dask cluster.
 MAX_WORKERS = 256
+#: Processes of a local Dask cluster when ``workers`` is not given.
+DEFAULT_WORKERS = 2
 #: Most grid points ``sweep`` returns as a DataFrame (about 1 kB a row); larger grids go to a file.
 MAX_FRAME_ROWS = 2_000_000
 
 
 # --- the run: output, work folder, engine ------------------------------------------------------------------------
 
-def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=None):
+def check_run(plan, output=None, *, engine=None, scheduler=None, workers=None, workdir=None):
     """The output, the engine and the work folder of a run, checked before any work: (engine, work folder).
 
     ``engine``: ``"inprocess"`` (default) or ``"dask"`` (implied by ``scheduler``, a Dask address such as
@@ -44,7 +45,7 @@ def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, work
             check_output(output, "output", TABLE_FORMATS)
         except ValueError as exc:
             raise InputError(str(exc), "output") from None
-    workers = read_count("workers", workers, 1, MAX_WORKERS)
+    workers = DEFAULT_WORKERS if workers is None else read_count("workers", workers, 1, MAX_WORKERS)
     if scheduler is not None:
         try:
             runs.engines.check_scheduler(scheduler)
@@ -69,7 +70,7 @@ def check_run(plan, output=None, *, engine=None, scheduler=None, workers=2, work
     return chosen, folder
 
 
-def run(plan, output=None, *, engine=None, scheduler=None, workers=2, workdir=None, fresh: bool = False,
+def run(plan, output=None, *, engine=None, scheduler=None, workers=None, workdir=None, fresh: bool = False,
         keep_columns=(), percentiles=PERCENTILES):
     """Execute ``plan`` (``runs.execute``) after ``check_run``; returns the ``RunSummary``.  ``fresh`` discards
     the parts of another job in the work folder (only a folder fruitimpact made and marked)."""
@@ -112,7 +113,7 @@ def batch_plan(input, output=None, chunk_size=CHUNK_ROWS) -> Plan:
     return Plan("batch", source, chunk_size)
 
 
-def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=2, workdir=None,
+def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=None, workdir=None,
           fresh: bool = False):
     """Characteristics of every row of a CSV or Parquet file of inputs, into a CSV or Parquet file.
 
@@ -132,7 +133,7 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
         ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
     scheduler : str, optional
         A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
-    workers : int or str
+    workers : int or str, optional
         Worker processes of a local Dask cluster, 1 to 256 (default 2).
     workdir : str or Path, optional
         The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
@@ -211,7 +212,7 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
     return Plan("sweep", grid, chunk_size, write_rows=write_rows), tuple(axes)
 
 
-def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=2, workdir=None,
+def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, workers=None, workdir=None,
           fresh: bool = False, **inputs):
     """Characteristics over a grid of inputs.
 
@@ -231,7 +232,7 @@ def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, wo
         ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
     scheduler : str, optional
         A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
-    workers : int or str
+    workers : int or str, optional
         Worker processes of a local Dask cluster, 1 to 256 (default 2).
     workdir : str or Path, optional
         The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
@@ -270,7 +271,7 @@ def sweep(output=None, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, wo
     plan, axes = sweep_plan(_texts(inputs), chunk_size)
     if output is not None:
         return run(plan, output, engine=engine, scheduler=scheduler, workers=workers, workdir=workdir, fresh=fresh)
-    asked = {"engine": engine is not None, "scheduler": scheduler is not None, "workers": workers != 2,
+    asked = {"engine": engine is not None, "scheduler": scheduler is not None, "workers": workers is not None,
              "workdir": workdir is not None, "fresh": bool(fresh)}
     for name, given in asked.items():
         if given:  # a run option without a run would be silently ignored
@@ -340,7 +341,7 @@ def check_percentiles(percentiles) -> tuple[float, ...]:
 
 def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=None, percentiles=PERCENTILES,
                thresholds=(), sample_size=SAMPLE_ROWS, output=None, chunk_size=CHUNK_ROWS, engine=None,
-               scheduler=None, workers=2, workdir=None, fresh: bool = False, **inputs):
+               scheduler=None, workers=None, workdir=None, fresh: bool = False, **inputs):
     """A Monte Carlo population of impacts: statistics, percentiles and threshold shares.
 
     Parameters
@@ -368,7 +369,7 @@ def population(rows=10_000, *, seed=0, spreads: bool = True, characteristics=Non
         ``"inprocess"`` (default: this process, every core through the compiled kernels) or ``"dask"``.
     scheduler : str, optional
         A Dask scheduler address (``tcp://10.0.0.5:8786``); implies ``engine="dask"``.
-    workers : int or str
+    workers : int or str, optional
         Worker processes of a local Dask cluster, 1 to 256 (default 2).
     workdir : str or Path, optional
         The work folder of the part files (default ``OUTPUT.parts``): new, empty, or one fruitimpact made.
