@@ -71,12 +71,12 @@ for the indices (``signals.indices``) and a model fit.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
 
+from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.filters import butterworth_sos, solve_small
 from fruitimpact.signals.settings import DetectorSettings, check_rate
 
@@ -557,8 +557,7 @@ class Detector:
         rate = check_rate(rate)
         if rate is None:
             raise ValueError("rate must be a finite number of Hz > 0; got None")
-        if isinstance(lanes, bool) or not isinstance(lanes, numbers.Integral) or not 1 <= lanes <= 1024:
-            raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
+        check_integer("lanes", lanes, 1, 1024)
         if settings is None:
             settings = DetectorSettings()
         if not isinstance(settings, DetectorSettings):

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 
 from fruitimpact.impact.units import parse_quantity
-from fruitimpact.impact.validation import InputError, check_number, is_boolean
+from fruitimpact.impact.validation import InputError, check_integer, check_number, is_boolean
 
 __all__ = ["DetectorSettings"]
 
@@ -96,9 +96,7 @@ class DetectorSettings:
         number("clip_high", optional=True)
         if self.clip_low is not None and self.clip_high is not None and not self.clip_low < self.clip_high:
             raise ValueError(f"clip_high must be > clip_low = {self.clip_low}; got {self.clip_high!r}")
-        order = self.lowpass_order
-        if isinstance(order, bool) or not isinstance(order, numbers.Integral) or not 1 <= order <= 8:
-            raise ValueError(f"lowpass_order must be an integer in [1, 8]; got {order!r}")
+        check_integer("lowpass_order", self.lowpass_order, 1, 8)
         harmonics = self.hum_harmonics
         if (not isinstance(harmonics, (tuple, list)) or not 1 <= len(harmonics) <= 4
                 or any(isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 1 <= k <= 16

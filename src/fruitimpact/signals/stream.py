@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import numbers
 import signal
 import socket
 import sys
@@ -34,6 +33,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.analysis import Analysis
 from fruitimpact.signals.detect import DetectedImpact, Detector, DetectorSettings
 
@@ -51,9 +51,7 @@ def _default_problem(message: str) -> None:
 
 
 def _lanes(lanes) -> int:
-    if isinstance(lanes, bool) or not isinstance(lanes, numbers.Integral) or not 1 <= lanes <= 1024:
-        raise ValueError(f"lanes must be an integer in [1, 1024]; got {lanes!r}")
-    return int(lanes)
+    return check_integer("lanes", lanes, 1, 1024)
 
 
 class _Problems:
@@ -431,11 +429,9 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
     client.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
     the socket is opened.
     """
-    if isinstance(port, bool) or not isinstance(port, numbers.Integral) or not 0 <= port <= 65535:
-        raise ValueError(f"port must be an integer in [0, 65535]; got {port!r}")
-    if max_clients is not None and (isinstance(max_clients, bool) or not isinstance(max_clients, (int, np.integer))
-                                    or max_clients < 1):
-        raise ValueError(f"max_clients must be None or an integer >= 1; got {max_clients!r}")
+    check_integer("port", port, 0, 65535)
+    if max_clients is not None:
+        check_integer("max_clients", max_clients, 1)
     StreamAnalyzer(rate, lanes, settings, on_impact, source=source, on_problem=on_problem,
                    analysis=analysis)  # checks the arguments
     summaries: list[dict] = []
