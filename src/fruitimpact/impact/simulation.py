@@ -299,7 +299,8 @@ class ImpactResult:
             return Curves(*plastic_curves(self.curve_points, **self.plastic_arguments))
         solver = get_solver(self.inputs.method)
         law = get_law(self.inputs.model)
-        return Curves(*solver.samples(law, self.law.stiffness, self.law.damping_factor, self.inputs.fruit.mass,
+        # the mass that moves: the reduced mass m m2/(m + m2) against a free partner (the characteristics' own)
+        return Curves(*solver.samples(law, self.law.stiffness, self.law.damping_factor, self.plastic_arguments["mass"],
                                       self.inputs.velocity, self.inputs.step, self.curve_points,
                                       self.characteristics.contact_duration))
 
