@@ -10,6 +10,7 @@ Playwright is missing; ``.ci/run`` sets FRUITIMPACT_BROWSER_TESTS=required and i
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import subprocess
@@ -84,7 +85,7 @@ def test_explorer_api_agrees_with_the_library(server):
     assert body["verdict"]["bruised"] is True and body["verdict"]["margin"] == reference.damage["bruise_margin"]
     assert body["safe_height"]["height"] == safe["safe_height"]
     assert body["command"] == "fruitimpact simulate --fruit apple --surface steel --drop-height 30cm --criterion shear"
-    drop = fi.drop("30cm", fruit="apple", surface="steel", criterion="shear", max_impacts=25)
+    drop = fi.drop("30cm", fruit="apple", surface="steel", criterion="shear")  # the command shown, as run
     assert [i["peak_force"] for i in body["drop"]["impacts"]] == [i["peak_force"] for i in drop["impacts"]]
 
 
@@ -102,6 +103,21 @@ def test_a_refused_input_gets_the_clis_line_and_names_its_control(server, reques
     assert body["argument"] in (list(request_)[0], list(request_))
 
 
+def test_the_risk_map_needs_a_criterion(server):
+    """Without one, risk_map judged by its own default while the page said "no criterion"."""
+    body = _post(server + "api/risk", {"fruit": "apple"})[1]
+    assert body["refused"] is True and body["argument"] == "criterion"
+    body = _post(server + "api/risk", {"fruit": "apple", "criterion": "shear"})[1]
+    safe = fi.safe_height(fruit="apple", surface="steel", criterion="shear", sensitivity=False)["safe_height"]
+    assert body["safe_height"]["steel"] == pytest.approx(safe, rel=1e-3)  # one root search of the whole grid
+
+
+def test_a_drop_that_has_not_come_to_rest_says_so(server):
+    """An undamped fruit still bounces after drop's impacts: the library's warning reaches the page."""
+    body = _post(server + "api/explore", {"fruit": "apple", "model": "hertz", "drop_height": "30cm"})[1]
+    assert any("still" in warning for warning in body["drop"]["warnings"]), body["drop"]["warnings"]
+
+
 def test_the_server_survives_every_bad_request(server):
     assert _post(server + "api/explore", None, raw=b"{not json")[0] == 400
     assert _post(server + "api/explore", None, raw=b"\xff\xfe")[0] == 400
@@ -112,6 +128,9 @@ def test_the_server_survives_every_bad_request(server):
     with pytest.raises((ConnectionError, urllib.error.URLError)):  # beyond 1 MB: not even read
         _post(server + "api/explore", None, raw=b" " * 3_000_000)
     assert _post(server + "api/explore", {"mass": "1e400"})[1]["refused"] is True
+    assert _post(server + "api/explore", None, raw=b"null")[1]["refused"] is True
+    assert _post(server + "api/explore", None, raw=b"[" * 5000)[0] == 400  # nested too deep to parse
+    assert _post(server + "api/explore", None, raw=b"9" * 60_000)[0] == 400  # beyond Python's int digits
     assert _post(server + "api/nothing", {})[0] == 404
     with pytest.raises(urllib.error.HTTPError) as refused:  # the explorer is a POST: a GET is 405, as JSON
         urllib.request.urlopen(server + "api/explore", timeout=30)
@@ -176,6 +195,9 @@ def test_the_explorer_in_a_real_browser(server, tmp_path):
         safe = fi.safe_height(fruit="apple", surface="steel", criterion="shear", sensitivity=False)["safe_height"]
         assert page.text_content("#safe-height") == f"{safe * 100:.3g} cm"
         assert page.is_visible("#safe-mark")
+        # the slider follows a typed height: log scale, 5 mm to 2 m over 0..1000
+        assert float(page.input_value("#height-slider")) == pytest.approx(1000 * math.log(0.3 / 0.005) / math.log(400),
+                                                                           abs=1)
 
         # the slider is the drop height: moved below the safe height, the verdict turns
         updates = page.evaluate("window.fruitimpact.updates")
@@ -189,6 +211,7 @@ def test_the_explorer_in_a_real_browser(server, tmp_path):
         page.fill("input[name=mass]", "-1")
         page.wait_for_selector(".field-error")
         assert page.text_content(".field-error") == _cli_error("--mass", "-1")
+        assert "stale" in page.get_attribute(".results", "class")  # the last good results, shown as such
         page.fill("input[name=mass]", "")
         _wait(page, "document.querySelectorAll('.field-error').length === 0")
 

@@ -19,15 +19,13 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 #: Inputs the explorer offers (a contract of its requests): the rest keep their defaults, as in
 #: ``fruitimpact simulate`` without those options.
 EXPLORER_INPUTS = ("fruit", "surface", "velocity", "drop_height", "model", "calibration", "criterion", "mass",
-                   "diameter", "modulus", "poisson", "restitution", "failure_stress")
+                   "diameter", "modulus", "poisson", "restitution", "failure_stress", "bruise_energy")
 #: Characteristics shown, in this order (``quantities.OUTPUTS`` gives label, unit and scale).
 SHOWN = ("peak_force", "time_to_peak", "contact_duration", "max_deflection", "restitution", "exit_velocity",
          "absorbed_energy", "firmness_c", "firmness_c_star", "max_pressure", "max_shear_stress", "contact_radius",
          "law_stiffness", "damping")
 #: Samples of the curves sent to the page (the accurate solver's curves over [0, T]).
 CURVE_POINTS = 401
-#: Impacts of the bounce sequence followed at most (``drop``'s own default is larger; the page shows the first).
-BOUNCES = 25
 
 
 def read_request(request) -> dict:
@@ -139,13 +137,14 @@ def _safe_height(inputs: dict) -> dict:
 def _bounces(drop, inputs: dict) -> dict:
     """The drop from the impact's height: each impact's time, speeds, peak force and verdict."""
     try:
-        sequence = drop(_drop_height(inputs), max_impacts=BOUNCES, **_without_impact(inputs))
+        sequence = drop(_drop_height(inputs), **_without_impact(inputs))
     except InputError as error:  # a drop the library refuses (a free partner): said on the page
         return {"error": str(error)}
     impacts = [{key: (_number(impact[key]) if key != "bruised" else impact[key])
                 for key in ("impact", "time", "velocity", "exit_velocity", "peak_force", "contact_duration",
                             "bruised", "bruise_volume")} for impact in sequence["impacts"]]
     return {"impacts": impacts, "status": sequence["status"], "message": sequence["message"],
+            "warnings": list(sequence["warnings"]),
             "rest_time": _number(sequence.get("rest_time")), "bruised": sequence.get("bruised"),
             "bruise_volume": _number(sequence.get("bruise_volume")), "command": command(inputs, "drop")}
 
@@ -157,6 +156,8 @@ def risk(request) -> dict:
 
     inputs = _without_impact(read_request(request))
     inputs.pop("surface", None)
+    if inputs.get("criterion", "none") == "none":  # risk_map would judge by its own default: say which
+        raise InputError("criterion must be given for the risk map: pressure, shear or energy", "criterion")
     mapped = risk_map(by="surface", **inputs)
     return {"heights": [float(h) for h in mapped["heights"]], "columns": list(mapped["columns"]),
             "margins": [[_number(row["bruise_margin"]) for row in mapped["rows"] if row["surface"] == column]

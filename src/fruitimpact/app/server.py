@@ -80,7 +80,7 @@ class ApiHandler(_Secure, tornado.web.RequestHandler):
         self._answer(status_code, {"error": self._reason})
 
     async def get(self):  # a route without inputs (the options)
-        await self._run(None)
+        await self._run()
 
     async def post(self):
         body = self.request.body
@@ -88,16 +88,13 @@ class ApiHandler(_Secure, tornado.web.RequestHandler):
             return self._answer(413, {"error": f"the request is {len(body):,} bytes; at most {MAX_REQUEST:,}"})
         try:
             request = json.loads(body.decode("utf-8")) if body else {}
-        except (UnicodeDecodeError, json.JSONDecodeError) as error:
-            return self._answer(400, {"error": f"the request is not JSON: {error}"})
-        await self._run(request)
+        except (ValueError, RecursionError) as error:  # not UTF-8, not JSON, nested too deep, a 5000-digit int
+            return self._answer(400, {"error": f"the request is not JSON: {str(error)[:200]}"})
+        await self._run((request,))
 
-    async def _run(self, request):
+    async def _run(self, arguments=()):
         try:
-            if request is None:
-                result = await asyncio.get_running_loop().run_in_executor(None, self.compute)
-            else:
-                result = await asyncio.get_running_loop().run_in_executor(None, self.compute, request)
+            result = await asyncio.get_running_loop().run_in_executor(None, self.compute, *arguments)
         except ValueError as error:  # the library's InputError: the CLI's line, and the input it names
             # answered 200, "refused": the request was read and judged (a browser logs every 4xx as a console
             # error; 4xx stays for requests that cannot be read at all)
@@ -123,11 +120,8 @@ def make_app() -> tornado.web.Application:
 
 
 def is_loopback(host: str) -> bool:
-    """Whether ``host`` is a loopback address (only this machine can connect)."""
-    try:
-        infos = socket.getaddrinfo(host, None)
-    except socket.gaierror:
-        return False
+    """Whether ``host`` is a loopback address (only this machine can connect); ``OSError`` if it is no address."""
+    infos = socket.getaddrinfo(host, None)
     import ipaddress
 
     return all(ipaddress.ip_address(info[4][0]).is_loopback for info in infos)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import importlib.util
 import sys
 
@@ -30,7 +31,11 @@ def cmd_serve(args) -> int:
     from fruitimpact.app import server
 
     host = args.host
-    if not server.is_loopback(host):
+    try:
+        loopback = server.is_loopback(host)
+    except OSError as error:
+        raise UsageError(f"argument --host: {host!r} is not an address: {error.strerror or error}") from None
+    if not loopback:
         print(f"{PROG} serve: warning: listening on {host}: anyone on that network can use this app "
               f"(it has no login)", file=sys.stderr)
 
@@ -40,6 +45,7 @@ def cmd_serve(args) -> int:
 
     try:
         server.serve(host, port, ready)
-    except OSError as error:  # the port taken, an address not on this machine
-        raise UsageError(f"argument --port: cannot listen on {host}:{port}: {error.strerror or error}") from None
+    except OSError as error:  # the port taken, or an address that is not this machine's
+        option = "--port" if error.errno == errno.EADDRINUSE else "--host"
+        raise UsageError(f"argument {option}: cannot listen on {host}:{port}: {error.strerror or error}") from None
     return 0

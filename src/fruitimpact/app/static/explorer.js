@@ -13,7 +13,11 @@ window.fruitimpact = {updates: 0, latency: null, last: null};
 const heightOf = (position) => HEIGHT_MIN * Math.pow(HEIGHT_MAX / HEIGHT_MIN, position / 1000);
 const positionOf = (height) => 1000 * Math.log(height / HEIGHT_MIN) / Math.log(HEIGHT_MAX / HEIGHT_MIN);
 const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
-const lengthText = (h) => h >= 1 ? `${fmt(h, 3)} m` : h >= 0.01 ? `${fmt(h * 100, 3)} cm` : `${fmt(h * 1000, 3)} mm`;
+// a length in the unit that suits it, to 3 digits (rounded first: 0.99999 m is "1 m", not "100 cm")
+const lengthText = (h) => {
+  const r = Number(h.toPrecision(3));
+  return r >= 1 ? `${fmt(r, 3)} m` : r >= 0.01 ? `${fmt(r * 100, 3)} cm` : `${fmt(r * 1000, 3)} mm`;
+};
 
 function fill(select, items, selected) {
   select.replaceChildren(...items.map((item) => {
@@ -30,7 +34,8 @@ function describe(kind) {
   document.getElementById(`${kind}-description`).textContent = item ? item.description : "";
 }
 
-function mode() { return form.querySelector("input[name=mode]:checked").value; }
+let currentMode = "velocity";  // how the impact is given: "velocity" or "drop_height"
+function mode() { return currentMode; }
 
 // The request: only what differs from `fruitimpact simulate`'s defaults, so that its command is the CLI's own.
 function request() {
@@ -40,7 +45,7 @@ function request() {
     const value = form.elements[name].value;
     if (value !== String(controls[name].default)) out[name] = value;
   }
-  for (const name of ["mass", "diameter", "modulus", "poisson", "failure_stress", "restitution"]) {
+  for (const name of ["mass", "diameter", "modulus", "poisson", "failure_stress", "bruise_energy", "restitution"]) {
     const value = form.elements[name].value.trim();
     if (value) out[name] = value;
   }
@@ -62,7 +67,10 @@ function clearErrors() {
 function showError(message, argument) {
   const names = Array.isArray(argument) ? argument : [argument];
   const control = names.map((name) => form.querySelector(`[data-input="${name}"]`)).find(Boolean);
+  document.querySelector(".results").classList.add("stale");
   if (control) {
+    const closed = control.closest("details:not([open])");
+    if (closed) closed.open = true;  // an error inside folded controls must be seen
     control.classList.add("invalid");
     const note = document.createElement("p");
     note.className = "field-error";
@@ -105,6 +113,7 @@ async function update(started) {
     return;
   }
   last = body;
+  document.querySelector(".results").classList.remove("stale");
   render(body);
   const latency = performance.now() - started;
   window.fruitimpact.updates += 1;
@@ -133,19 +142,23 @@ function render(result) {
     return tr;
   });
   document.querySelector("#characteristics tbody").replaceChildren(...rows);
-  const warnings = [...result.warnings, ...(result.status !== "ok" ? [`${result.status}: ${result.message}`] : [])];
+  const dropWarnings = result.drop && result.drop.warnings ? result.drop.warnings.filter((w) => !result.warnings.includes(w)) : [];
+  const warnings = [...result.warnings, ...(result.status !== "ok" ? [`${result.status}: ${result.message}`] : []),
+    ...dropWarnings.map((w) => `drop: ${w}`)];
   document.getElementById("warnings").replaceChildren(...warnings.map((text) => Object.assign(document.createElement("li"), {textContent: text})));
   document.getElementById("command").textContent = result.command;
   document.getElementById("drop-command").textContent = result.drop && result.drop.command ? result.drop.command : "";
-  if (mode() === "velocity") slider.value = positionOf(Math.min(Math.max(result.drop_height, HEIGHT_MIN), HEIGHT_MAX));
+  slider.value = positionOf(Math.min(Math.max(result.drop_height, HEIGHT_MIN), HEIGHT_MAX));  // the slider is the height
 }
 
 // The fruit's height between impacts: each flight a parabola from the exit speed, up to the rest.
 function renderBounces(result) {
   const svg = document.getElementById("chart-bounce");
   const drop = result.drop;
+  const caption = document.getElementById("bounce-caption");
   if (!drop || drop.error) {
-    Charts.line(svg, {series: [], xLabel: "time [s]", yLabel: "height [cm]", empty: drop ? drop.error : "no drop"});
+    caption.textContent = `bounce sequence: ${drop ? drop.error : "no drop"}`;
+    Charts.line(svg, {series: [], xLabel: "time [s]", yLabel: "height [cm]", empty: "no bounce sequence (see above)"});
     return;
   }
   const x = [], y = [];
@@ -159,8 +172,8 @@ function renderBounces(result) {
   const bruising = drop.impacts.filter((impact) => impact.bruised);
   const markers = bruising.map((impact, i) => ({x: impact.time, label: i ? "" : `${bruising.length} bruising impact${bruising.length > 1 ? "s" : ""}`}));
   Charts.line(svg, {series: [{x, y, color: "#9a5b00"}], xLabel: "time [s]", yLabel: "height [cm]", xMin: 0, yMin: 0, markers});
-  document.getElementById("bounce-caption").textContent =
-    `bounce sequence: ${drop.impacts.length} impacts from ${lengthText(h0)}, at rest after ${fmt(drop.rest_time, 3)} s`;
+  const end = drop.status === "ok" && !drop.warnings.length ? `at rest after ${fmt(drop.rest_time, 3)} s` : `${drop.status}, see the warnings`;
+  caption.textContent = `bounce sequence: ${drop.impacts.length} impacts from ${lengthText(h0)}, ${end}`;
 }
 
 function renderVerdict(result) {
@@ -236,6 +249,11 @@ async function exportAs(kind) {
 }
 
 function setMode(value) {
+  if (last && value !== currentMode) {  // carry the impact over: the same impact, given the other way
+    if (value === "velocity") form.elements.velocity.value = String(Number(last.velocity.toPrecision(4)));
+    else form.elements.drop_height.value = lengthText(last.drop_height).replace(" ", "");
+  }
+  currentMode = value;
   form.querySelector(`input[name=mode][value=${value}]`).checked = true;
   document.getElementById("velocity-control").hidden = value !== "velocity";
   document.getElementById("height-control").hidden = value !== "drop_height";
@@ -252,9 +270,15 @@ async function start() {
   fill(form.elements.criterion, options.criteria, controls.criterion.default);
   describe("fruit");
   describe("surface");
+  document.getElementById("height-scale").replaceChildren(...[0.005, 0.05, 0.5, 2].map((h) => {
+    const label = Object.assign(document.createElement("span"), {textContent: lengthText(h)});
+    label.style.left = `${positionOf(h) / 10}%`;  // where the log slider puts that height
+    return label;
+  }));
   form.addEventListener("input", (event) => {
     if (event.target === slider) return;
     if (event.target.name === "mode") setMode(event.target.value);
+    document.getElementById("chart-risk").setAttribute("hidden", "");  // drawn for other inputs
     if (event.target.name === "fruit" || event.target.name === "surface") describe(event.target.name);
     schedule(event.target.tagName === "INPUT" && event.target.type !== "radio" ? 120 : 10);  // typing: a pause
   });
