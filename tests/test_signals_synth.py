@@ -372,3 +372,11 @@ def test_population_refuses_bad_classes(classes):
 def test_population_refuses_jitter_beyond_half_a_slot():
     with pytest.raises(ValueError, match=r"Population.jitter must be a finite number >= 0 and <= 0.05"):
         Population(count=2, interval=0.1, **APPLE, velocity=1.0, restitution=E, classes=CLASSES, jitter=0.06)
+
+
+@pytest.mark.parametrize("name", ["modulus_spread", "mass_spread"])
+def test_population_refuses_a_spread_whose_draws_overflow(name):
+    # a lognormal sd of 6e5 (a modulus typed where its spread goes) drew E = inf: a StopIteration traceback in
+    # the class lookup.  Beyond 2 (a factor e² per sd) no fruit population is meant.
+    with pytest.raises(ValueError, match=rf"Population.{name} must be a finite number >= 0 and <= 2"):
+        Population(count=2, interval=0.1, **APPLE, velocity=1.0, restitution=E, classes=CLASSES, **{name: 6e5})

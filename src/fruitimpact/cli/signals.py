@@ -283,7 +283,8 @@ SYNTH_DROP_HEIGHT, SYNTH_RESTITUTION = "5cm", "0.577"
 def cmd_synth(args) -> int:
     from fruitimpact.signals import read as reading
     from fruitimpact.signals.options import parse_clip
-    from fruitimpact.signals.synth import Population, SensorModel, synthesize, truth_path, write_recording, write_truth
+    from fruitimpact.signals.synth import (MAX_LOG_SPREAD, Population, SensorModel, synthesize, truth_path,
+                                           write_recording, write_truth)
 
     fmt = _library_call(reading.recording_format, args.output, args.format, "--format")
     check_outputs(("-o/--output", args.output, None if args.format else dict(reading.EXTENSIONS)))
@@ -324,8 +325,10 @@ def cmd_synth(args) -> int:
         restitution=_float("--restitution", args.restitution, "dimensionless", high=1.0)
         if args.restitution is not None else None,
         alpha=_float("--alpha", args.alpha, "alpha", low_inclusive=True) if args.alpha is not None else None,
-        modulus_spread=_float("--modulus-spread", args.modulus_spread, "dimensionless", low_inclusive=True),
-        mass_spread=_float("--mass-spread", args.mass_spread, "dimensionless", low_inclusive=True),
+        modulus_spread=_float("--modulus-spread", args.modulus_spread, "dimensionless", low_inclusive=True,
+                              high=MAX_LOG_SPREAD),
+        mass_spread=_float("--mass-spread", args.mass_spread, "dimensionless", low_inclusive=True,
+                           high=MAX_LOG_SPREAD),
         jitter=_float("--jitter", args.jitter, "time", low_inclusive=True), rebounds=int(rebounds),
         lanes=int(lanes), seed=sensor_kwargs["seed"] + 1)
     recording, truth = _library_call(synthesize, sensor, population, lanes=int(lanes))

@@ -69,6 +69,10 @@ _DIMENSIONS = {"mass": "mass", "diameter": "length", "modulus": "modulus", "pois
                "plate_damping": "dimensionless"}
 
 
+#: Largest lognormal spread (sd of ln E, ln m) of a synthetic population: a factor e² per sd.
+MAX_LOG_SPREAD = 2.0
+
+
 def _number(owner: str, name: str, value, **bounds):
     """``validation.check_number`` with the settings object's name in the message; a string is read with its
     unit first (``_DIMENSIONS``)."""
@@ -332,8 +336,10 @@ class Population:
         for name in ("mass", "diameter", "modulus"):
             object.__setattr__(self, name, _number(o, name, getattr(self, name), low=0.0, low_inclusive=False))
         object.__setattr__(self, "poisson", _number(o, "poisson", self.poisson))
-        for name in ("modulus_spread", "mass_spread", "start"):
-            object.__setattr__(self, name, _number(o, name, getattr(self, name), low=0.0))
+        for name in ("modulus_spread", "mass_spread"):  # beyond 2 (a factor e² per sd) the draws overflow to inf
+            object.__setattr__(self, name, _number(o, name, getattr(self, name), low=0.0, high=MAX_LOG_SPREAD,
+                                                   high_inclusive=True))
+        object.__setattr__(self, "start", _number(o, "start", self.start, low=0.0))
         object.__setattr__(self, "jitter", _number(o, "jitter", self.jitter, low=0.0, high=self.interval / 2,
                                                    high_inclusive=True))
         object.__setattr__(self, "rebounds", _integer(o, "rebounds", self.rebounds, 0, 2))
