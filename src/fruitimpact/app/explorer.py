@@ -169,6 +169,7 @@ def risk(request) -> dict:
 def options() -> dict:
     """What the page's controls offer: the libraries, the registries, and every input's default, unit and
     option, so that the page opens on ``fruitimpact simulate``'s default impact."""
+    from fruitimpact.app.uploads import MAX_UPLOAD
     from fruitimpact.impact.registries import REGISTRIES
     from fruitimpact.library import catalogue
 
@@ -185,6 +186,7 @@ def options() -> dict:
         "models": list(REGISTRIES["model"]), "calibrations": list(REGISTRIES["calibration"]),
         "criteria": [name for name in REGISTRIES["criterion"] if name != "preset"],
         "controls": controls,
+        "upload_limit": MAX_UPLOAD,  # the recording page's and the monitor's
     }
 
 

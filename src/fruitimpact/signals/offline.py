@@ -7,6 +7,8 @@ bounded by the chunk, not the recording.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 #: Samples per lane read and analysed at once (memory is bounded by this, not by the recording).
 ANALYZE_CHUNK = 1 << 18
 
@@ -61,8 +63,32 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     The firmness indices C = F_max/t_c and C* = F_max/t_c² are eqs 1–2 of "Theoretical aspects about simulating
     the reaction to impact of apples on rigid plane surfaces"; the fitted force law is its Hunt–Crossley model.
     """
-    import numpy as np
     import pandas as pd
+
+    run = run_analysis(source, rate=rate, column=column, format=format, lanes=lanes, **options)
+    return pd.DataFrame(run.rows, columns=run.columns)
+
+
+@dataclass
+class AnalysisRun:
+    """What :func:`run_analysis` found: the rows of ``analyze``'s table, its columns, the recording's lanes,
+    rate [Hz], first sample's time [s] and samples per lane fed, and the firmness classes used (or None)."""
+
+    rows: list
+    columns: list
+    lane_names: list
+    rate: float
+    start_time: float
+    samples: int
+    classes: object = None
+
+
+def run_analysis(source, *, rate=None, column: str | None = None, format: str | None = None, lanes: int = 1,
+                 on_detected=None, on_chunk=None, **options) -> AnalysisRun:
+    """:func:`analyze`'s work, with two hooks for a caller that shows more than the table (the web app):
+    ``on_detected(impact, report)`` with each ``DetectedImpact`` (its window of samples) and its full report
+    (the fit included), and ``on_chunk(samples)`` with each chunk of samples (n, lanes) as it is fed."""
+    import numpy as np
 
     from fruitimpact.impact.validation import InputError, check_integer
     from fruitimpact.signals.analysis import public, report_columns
@@ -109,14 +135,27 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
         chunks = (samples[i:i + ANALYZE_CHUNK] for i in range(0, samples.shape[0], ANALYZE_CHUNK))
     settings, analysis = analysis_settings(rate_value, True, **options)
     rows = []
-    analyzer = StreamAnalyzer(rate_value, len(names), settings, lambda report: None,
-                              on_detected=lambda impact, report: rows.append(public(report)), analysis=analysis,
-                              lane_names=names, start_time=start)
-    feed_all(analyzer, chunks)
+
+    def detected(impact, report):
+        rows.append(public(report))
+        if on_detected is not None:
+            on_detected(impact, report)
+
+    analyzer = StreamAnalyzer(rate_value, len(names), settings, lambda report: None, on_detected=detected,
+                              analysis=analysis, lane_names=names, start_time=start)
+    if on_chunk is not None:
+        chunks = _watched(chunks, on_chunk)
+    samples_fed = feed_all(analyzer, chunks)
     # the same columns in the same order whatever the contacts (a quiet recording, a fit that never converged)
     columns = list(report_columns(analysis))
     columns += [key for key in dict.fromkeys(k for row in rows for k in row) if key not in columns]
-    return pd.DataFrame(rows, columns=columns)
+    return AnalysisRun(rows, columns, names, rate_value, start, samples_fed, analysis.classes)
+
+
+def _watched(chunks, on_chunk):
+    for chunk in chunks:
+        on_chunk(chunk)
+        yield chunk
 
 
 def feed_all(analyzer, chunks, on_chunk=None) -> int:

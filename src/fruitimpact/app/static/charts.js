@@ -32,7 +32,7 @@ const Charts = (() => {
 
   function format(v) {
     const a = Math.abs(v);
-    if (a !== 0 && (a >= 1e5 || a < 1e-3)) return v.toExponential(1);
+    if (a !== 0 && (a >= 1e5 || a < 1e-3)) return v.toExponential(1).replace(".0e", "e").replace("e+", "e");  // 4e7, 2.5e7
     return String(Number(v.toPrecision(4)));
   }
 
@@ -46,7 +46,8 @@ const Charts = (() => {
     return {width, height, left: 56, right: 14, top: 12, bottom: 38};
   }
 
-  // spec: {series: [{x: [], y: [], color, label, dash}], xLabel, yLabel, xMin, yMin, markers: [{x, label, color}]}
+  // spec: {series: [{x: [], y: [], color, label, dash}], xLabel, yLabel, xMin, yMin, markers: [{x, label, color}],
+  //        hLines: [y] (dashed reference lines), dots (draw points, not lines)}
   function line(svg, spec) {
     const f = frame(svg);
     const xs = spec.series.flatMap((s) => s.x), ys = spec.series.flatMap((s) => s.y).filter(Number.isFinite);
@@ -54,6 +55,7 @@ const Charts = (() => {
     let x0 = spec.xMin ?? Math.min(...xs), x1 = Math.max(...xs);
     let y0 = spec.yMin ?? Math.min(0, ...ys), y1 = Math.max(...ys);
     if (y1 === y0) y1 = y0 + 1;
+    if (!(x1 > x0)) { x0 -= 0.5; x1 = x0 + 1; }  // one point: a unit span around it
     y1 += (y1 - y0) * 0.06;
     const W = f.width - f.left - f.right, H = f.height - f.top - f.bottom;
     const sx = (x) => f.left + (x - x0) / (x1 - x0) * W, sy = (y) => f.top + H - (y - y0) / (y1 - y0) * H;
@@ -69,7 +71,14 @@ const Charts = (() => {
     el("line", {x1: f.left, x2: f.left, y1: f.top, y2: f.top + H, class: "axis"}, svg);
     el("text", {x: f.left + W / 2, y: f.height - 6, "text-anchor": "middle", class: "label"}, svg).textContent = spec.xLabel;
     el("text", {x: 14, y: f.top + H / 2, "text-anchor": "middle", class: "label", transform: `rotate(-90 14 ${f.top + H / 2})`}, svg).textContent = spec.yLabel;
+    for (const y of spec.hLines || []) {  // horizontal reference lines (class thresholds)
+      if (y >= y0 && y <= y1) el("line", {x1: f.left, x2: f.left + W, y1: sy(y), y2: sy(y), stroke: "#8a96a3", "stroke-dasharray": "4 3"}, svg);
+    }
     for (const s of spec.series) {
+      if (spec.dots) {  // points, not a line (one fruit each)
+        s.x.forEach((x, i) => { if (Number.isFinite(s.y[i])) el("circle", {cx: sx(x).toFixed(1), cy: sy(s.y[i]).toFixed(1), r: 2.5, fill: s.color || "#2f6f4f"}, svg); });
+        continue;
+      }
       const d = s.x.map((x, i) => Number.isFinite(s.y[i]) ? `${i ? "L" : "M"}${sx(x).toFixed(1)},${sy(s.y[i]).toFixed(1)}` : "").join("");
       el("path", {d, fill: "none", stroke: s.color || "#2f6f4f", "stroke-width": 2, "stroke-dasharray": s.dash || "none"}, svg);
     }
@@ -118,6 +127,81 @@ const Charts = (() => {
     el("text", {x: 14, y: f.top + H / 2, "text-anchor": "middle", class: "label", transform: `rotate(-90 14 ${f.top + H / 2})`}, svg).textContent = spec.yLabel;
   }
 
+  // Grouped bars over named categories.  spec: {categories: [], series: [{values: [], color, label}], yLabel,
+  // xLabel, highlight: index of a category to mark (e.g. the worst transfer point), yMax, format(v) for labels}
+  function bars(svg, spec) {
+    const f = frame(svg);
+    f.bottom = 46;
+    const n = spec.categories.length, k = spec.series.length;
+    const values = spec.series.flatMap((s) => s.values).filter(Number.isFinite);
+    if (!n || !values.length) { el("text", {x: f.width / 2, y: f.height / 2, "text-anchor": "middle"}, svg).textContent = spec.empty || "no data"; return; }
+    const W = f.width - f.left - f.right, H = f.height - f.top - f.bottom;
+    let y1 = spec.yMax ?? Math.max(...values);
+    if (!(y1 > 0)) y1 = 1;
+    y1 *= spec.yMax ? 1 : 1.08;
+    const sy = (y) => f.top + H - y / y1 * H;
+    for (const t of ticks(0, y1, 5)) {
+      el("line", {x1: f.left, x2: f.left + W, y1: sy(t), y2: sy(t), class: "grid"}, svg);
+      el("text", {x: f.left - 6, y: sy(t) + 4, "text-anchor": "end"}, svg).textContent = (spec.tick || format)(t);
+    }
+    const slot = W / n, width = Math.min(46, slot * 0.8 / k);
+    spec.categories.forEach((name, c) => {
+      const middle = f.left + (c + 0.5) * slot;
+      if (c === spec.highlight) el("rect", {x: f.left + c * slot + 1, y: f.top, width: slot - 2, height: H, fill: "#fbeceb"}, svg);
+      spec.series.forEach((s, j) => {
+        const v = s.values[c];
+        if (!Number.isFinite(v)) return;
+        const x = middle - k * width / 2 + j * width;
+        el("rect", {x, y: sy(v), width: width - 2, height: Math.max(0, f.top + H - sy(v)), fill: s.color || "#2f6f4f"}, svg)
+          .appendChild(document.createElementNS(NS, "title")).textContent = `${name}: ${s.label || ""} ${(spec.format || format)(v)}`;
+      });
+      const label = name.length > 16 ? name.slice(0, 15) + "…" : name;
+      el("text", {x: middle, y: f.top + H + 15, "text-anchor": "middle", fill: c === spec.highlight ? "#b3261e" : "#5b6775"}, svg).textContent = label;
+    });
+    el("line", {x1: f.left, x2: f.left + W, y1: f.top + H, y2: f.top + H, class: "axis"}, svg);
+    el("line", {x1: f.left, x2: f.left, y1: f.top, y2: f.top + H, class: "axis"}, svg);
+    if (spec.xLabel) el("text", {x: f.left + W / 2, y: f.height - 6, "text-anchor": "middle", class: "label"}, svg).textContent = spec.xLabel;
+    el("text", {x: 14, y: f.top + H / 2, "text-anchor": "middle", class: "label", transform: `rotate(-90 14 ${f.top + H / 2})`}, svg).textContent = spec.yLabel;
+    spec.series.filter((s) => s.label).forEach((s, i) => {
+      const y = f.top + 12 + 15 * i;
+      el("rect", {x: f.left + W - 150, y: y - 9, width: 12, height: 10, fill: s.color || "#2f6f4f"}, svg);
+      el("text", {x: f.left + W - 134, y}, svg).textContent = s.label;
+    });
+  }
+
+  // A histogram: counts over bins [edges[i], edges[i+1]), with labelled vertical markers (class thresholds).
+  // spec: {edges: [], counts: [], xLabel, yLabel, markers: [{x, label, color}], colors: [] per bin (optional)}
+  function histogram(svg, spec) {
+    const f = frame(svg);
+    const edges = spec.edges, counts = spec.counts;
+    if (!counts.length || !edges.length) { el("text", {x: f.width / 2, y: f.height / 2, "text-anchor": "middle"}, svg).textContent = spec.empty || "no data"; return; }
+    const W = f.width - f.left - f.right, H = f.height - f.top - f.bottom;
+    const x0 = edges[0], x1 = edges[edges.length - 1] > x0 ? edges[edges.length - 1] : x0 + 1;
+    const y1 = Math.max(1, ...counts) * 1.08;
+    const sx = (x) => f.left + (x - x0) / (x1 - x0) * W, sy = (y) => f.top + H - y / y1 * H;
+    for (const t of ticks(0, y1, 5)) {
+      if (t !== Math.round(t)) continue;
+      el("line", {x1: f.left, x2: f.left + W, y1: sy(t), y2: sy(t), class: "grid"}, svg);
+      el("text", {x: f.left - 6, y: sy(t) + 4, "text-anchor": "end"}, svg).textContent = format(t);
+    }
+    for (const t of ticks(x0, x1, 6)) el("text", {x: sx(t), y: f.top + H + 15, "text-anchor": "middle"}, svg).textContent = format(t);
+    counts.forEach((count, i) => {
+      if (!count) return;
+      el("rect", {x: sx(edges[i]) + 0.5, y: sy(count), width: Math.max(1, sx(edges[i + 1]) - sx(edges[i]) - 1), height: f.top + H - sy(count),
+                  fill: (spec.colors && spec.colors[i]) || "#2f6f4f"}, svg)
+        .appendChild(document.createElementNS(NS, "title")).textContent = `${format(edges[i])} to ${format(edges[i + 1])}: ${count}`;
+    });
+    el("line", {x1: f.left, x2: f.left + W, y1: f.top + H, y2: f.top + H, class: "axis"}, svg);
+    el("line", {x1: f.left, x2: f.left, y1: f.top, y2: f.top + H, class: "axis"}, svg);
+    (spec.markers || []).forEach((m, i) => {  // labels staggered: two close thresholds stay readable
+      if (!(m.x >= x0 && m.x <= x1)) return;
+      el("line", {x1: sx(m.x), x2: sx(m.x), y1: f.top, y2: f.top + H, stroke: m.color || "#1d2630", "stroke-dasharray": "4 3"}, svg);
+      el("text", {x: sx(m.x) + 4, y: f.top + 11 + 14 * (i % 3), fill: m.color || "#1d2630"}, svg).textContent = m.label;
+    });
+    el("text", {x: f.left + W / 2, y: f.height - 6, "text-anchor": "middle", class: "label"}, svg).textContent = spec.xLabel;
+    el("text", {x: 14, y: f.top + H / 2, "text-anchor": "middle", class: "label", transform: `rotate(-90 14 ${f.top + H / 2})`}, svg).textContent = spec.yLabel;
+  }
+
   function serialize(svg) {
     return new XMLSerializer().serializeToString(svg);
   }
@@ -141,5 +225,5 @@ const Charts = (() => {
     });
   }
 
-  return {line, heat, serialize, png};
+  return {line, heat, bars, histogram, serialize, png, format};
 })();
