@@ -95,7 +95,10 @@ class Monitor:
             self.port = read_count("port", inputs.pop("port", 0), 0, 65535)
             self.lane_names = [f"lane{k}" for k in range(lanes)]
             self.file = None
-        self.settings, self.analysis = analysis_settings(self.rate, True, **options)
+        try:
+            self.settings, self.analysis = analysis_settings(self.rate, True, **options)
+        except ValueError as error:
+            raise refusal(error) from None
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._reports: list[dict] = []

@@ -92,10 +92,11 @@ def read_request(request, names=RECORDING_INPUTS) -> dict:
 _OPTION_NAMES = {option: name for name, option in ANALYSIS_OPTIONS.items()}
 
 
-def refusal(error: ValueError, stored, shown: str) -> InputError:
-    """A library refusal as the page shows it: the stored file's path replaced by the name the user's file had,
-    and the input it is about (from the error, or from the ``argument --option:`` the message starts with)."""
-    text = str(error).replace(str(stored), shown)
+def refusal(error: ValueError, stored=None, shown: str = "") -> InputError:
+    """A library refusal as the page shows it: the ``stored`` file's path replaced by the name the user's file had
+    (``shown``), and the input it is about (from the error, or from the ``argument --option:`` the message starts
+    with)."""
+    text = str(error) if stored is None else str(error).replace(str(stored), shown)
     argument = getattr(error, "argument", None)
     if argument == "path":
         argument = "file"
@@ -234,7 +235,7 @@ def analyze(request, uploads) -> dict:
     thresholds = list(run.classes.thresholds) if run.classes is not None else []
     classes = {}
     for row in rows:
-        if "class" in row and not row.get("rebound"):
+        if row.get("class") is not None and not row.get("rebound"):  # an overlap has no class
             classes[row["class"]] = classes.get(row["class"], 0) + 1
     key = ANALYSES.add({"windows": windows, "rate": run.rate, "rows": rows})
     fruit = sum(1 for row in rows if not row.get("rebound"))
@@ -283,4 +284,4 @@ def impact(request) -> dict:
     return out
 
 
-__all__ = ["ANALYSES", "MAX_WINDOWS", "RECORDING_INPUTS", "analyze", "command", "impact", "read_request"]
+__all__ = ["ANALYSES", "MAX_WINDOWS", "RECORDING_INPUTS", "analyze", "command", "impact", "read_request", "refusal"]

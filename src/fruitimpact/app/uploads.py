@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fruitimpact.impact.validation import InputError
-from fruitimpact.signals.read.common import EXTENSIONS
+from fruitimpact.signals.read.common import error as read_error
 
 #: Largest upload [bytes] (stated on the page): a 4-lane float32 recording of 20 min at 10 kHz.
 MAX_UPLOAD = 200 * 1024 * 1024
@@ -59,12 +59,14 @@ class Upload:
 
 def extension_of(name: str) -> str:
     """The recording extension of an uploaded file's name (lower case); ``InputError`` naming ``file`` if it is
-    not one the readers take."""
-    suffix = Path(str(name)).suffix.lower()
-    if suffix not in EXTENSIONS:
-        raise InputError(f"file {name!r}: unsupported format {suffix or '(no extension)'!r} (allowed: "
-                         f"{', '.join(EXTENSIONS)})", "file")
-    return suffix
+    not one the readers take (their own message)."""
+    from fruitimpact.signals.read import recording_format
+
+    try:
+        recording_format(name)  # the readers' own refusal, as `fruitimpact analyze` words it
+    except ValueError as error:
+        raise InputError(str(error), "file") from None
+    return Path(str(name)).suffix.lower()
 
 
 class UploadStore:
@@ -129,7 +131,7 @@ class _Writer:
         self.handle.close()
         if self.size == 0:
             self.partial.unlink(missing_ok=True)
-            raise InputError(f"file {self.name!r} is empty", "file")
+            raise read_error(self.name, "empty file", "file")
         os.replace(self.partial, self.path)
         upload = Upload(self.id, self.name, self.path, self.size, self.digest.hexdigest())
         self.store._add(upload)

@@ -322,7 +322,7 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
                      "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
                      "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size",
-                     "rate": "--rate"}
+                     "rate": "--rate", "file": "FILE"}  # file: analyze's recording (the web app's upload)
 
 
 __all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag",
