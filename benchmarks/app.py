@@ -7,7 +7,8 @@ the same computation called in process (``app.explorer.explore``), the server's 
 
     python benchmarks/app.py [--screenshots docs/img]
 
-``--screenshots DIR`` also writes the explorer as a user sees it (``DIR/explorer.png``).
+``--screenshots DIR`` also writes the explorer as a user sees it (``DIR/explorer.png``) and the line-audit page as
+it opens (``DIR/line-audit.png``).
 """
 
 from __future__ import annotations
@@ -45,6 +46,18 @@ def measure(page, action, repeats: int) -> list[float]:
         wait(page, f"window.fruitimpact.updates > {count}")
         out.append(page.evaluate("window.fruitimpact.latency"))
     return out
+
+
+def line_screenshot(browser, url: str, folder: Path) -> Path:
+    """The line-audit page as it opens (the example line audited), a 1400 × 1000 window: ``folder/line-audit.png``."""
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page.goto(url + "line")
+    wait(page, "window.fruitimpact.updates >= 1")
+    page.wait_for_timeout(300)
+    path = folder / "line-audit.png"
+    page.screenshot(path=str(path))
+    page.close()
+    return path
 
 
 def main() -> None:
@@ -100,6 +113,7 @@ def main() -> None:
                 page.wait_for_timeout(300)
                 page.screenshot(path=str(folder / "explorer.png"))
                 print(f"screenshot written to {folder / 'explorer.png'}")
+                print(f"screenshot written to {line_screenshot(browser, url, folder)}")
             browser.close()
     finally:
         process.terminate()
