@@ -131,7 +131,7 @@ const Charts = (() => {
   // xLabel, highlight: index of a category to mark (e.g. the worst transfer point), yMax, format(v) for labels}
   function bars(svg, spec) {
     const f = frame(svg);
-    f.bottom = 46;
+    f.bottom = 52;
     const n = spec.categories.length, k = spec.series.length;
     const values = spec.series.flatMap((s) => s.values).filter(Number.isFinite);
     if (!n || !values.length) { el("text", {x: f.width / 2, y: f.height / 2, "text-anchor": "middle"}, svg).textContent = spec.empty || "no data"; return; }
@@ -155,8 +155,17 @@ const Charts = (() => {
         el("rect", {x, y: sy(v), width: width - 2, height: Math.max(0, f.top + H - sy(v)), fill: s.color || "#2f6f4f"}, svg)
           .appendChild(document.createElementNS(NS, "title")).textContent = `${name}: ${s.label || ""} ${(spec.format || format)(v)}`;
       });
-      const label = name.length > 16 ? name.slice(0, 15) + "…" : name;
-      el("text", {x: middle, y: f.top + H + 15, "text-anchor": "middle", fill: c === spec.highlight ? "#b3261e" : "#5b6775"}, svg).textContent = label;
+      // a long name on two lines, broken at the space nearest its middle (each line cut at 20 characters)
+      const cut = (t) => t.length > 20 ? t.slice(0, 19) + "…" : t;
+      let lines = [name];
+      if (name.length > 16 && name.includes(" ")) {
+        const spaces = [...name].map((ch, i) => ch === " " ? i : -1).filter((i) => i > 0);
+        const at = spaces.reduce((best, i) => Math.abs(i - name.length / 2) < Math.abs(best - name.length / 2) ? i : best);
+        lines = [name.slice(0, at), name.slice(at + 1)];
+      }
+      lines.forEach((text, j) => {
+        el("text", {x: middle, y: f.top + H + 15 + 13 * j, "text-anchor": "middle", fill: c === spec.highlight ? "#b3261e" : "#5b6775"}, svg).textContent = cut(text);
+      });
     });
     el("line", {x1: f.left, x2: f.left + W, y1: f.top + H, y2: f.top + H, class: "axis"}, svg);
     el("line", {x1: f.left, x2: f.left, y1: f.top, y2: f.top + H, class: "axis"}, svg);

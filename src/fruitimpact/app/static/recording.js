@@ -138,7 +138,9 @@ function drawHistogram(a) {
   const h = a.histogram;
   const label = {firmness_c_star: "firmness C* [N/s²]", firmness_c: "firmness C [N/s]", peak_force: "peak force [N]",
                  stiffness: "fitted stiffness", modulus: "fitted modulus [Pa]"}[h.index] || h.index;
-  document.getElementById("histogram-caption").textContent = `${label} of the ${h.fruit} fruit (first contacts; rebounds left out)`;
+  document.getElementById("histogram-caption").textContent = h.fruit === a.fruit
+    ? `${label} of the ${a.fruit} fruit (first contacts; rebounds left out)`
+    : `${label} of ${h.fruit} of the ${a.fruit} fruit (the others, overlaps and clipped contacts, have none)`;
   const classOf = (x) => h.thresholds.filter((t) => x >= t).length;
   const colors = h.thresholds.length ? h.edges.slice(0, -1).map((e, i) => CLASS_COLORS[classOf((e + h.edges[i + 1]) / 2) % CLASS_COLORS.length]) : null;
   Charts.histogram(document.getElementById("chart-histogram"), {
