@@ -233,21 +233,25 @@ class Monitor:
 
     # ------------------------------------------------------------------ reports
     def _detected(self, impact, report) -> None:
-        window = impact.window
+        # only kept here: the curve (and its model) is built for the latest contact of a lane when a frame goes
+        with self._lock:
+            self._curves[report["lane"]] = (impact.window_start, impact.window, report.get("_fit"),
+                                            report.get("start_time"), report.get("peak_force"))
+
+    def _curve(self, window_start: int, window: np.ndarray, fit, start_time, peak_force) -> dict:
+        """A lane's latest contact for the page: its samples (decimated to ``CURVE_POINTS``) over time in its
+        window [ms], and the fitted model at the same times when the fit converged."""
         step = max(1, window.size // CURVE_POINTS)
-        time_ms = (np.arange(0, window.size, step) / self.rate * 1e3)
-        curve = {"time": time_ms.tolist(), "force": window[::step].astype(float).tolist(), "model": None,
-                 "start_time": report.get("start_time"), "peak_force": report.get("peak_force")}
-        fit = report.get("_fit")
+        index = np.arange(0, window.size, step)
+        curve = {"time": (index / self.rate * 1e3).tolist(), "force": window[::step].astype(float).tolist(),
+                 "model": None, "start_time": start_time, "peak_force": peak_force}
         if fit and fit.get("converged"):
             from fruitimpact.signals.fit import model_curve
 
-            t = (impact.window_start + np.arange(0, window.size, step)) / self.rate
-            model = model_curve(t, fit)
+            model = model_curve((window_start + index) / self.rate, fit)
             if np.isfinite(model).all():
                 curve["model"] = model.tolist()
-        with self._lock:
-            self._curves[report["lane"]] = curve
+        return curve
 
     def _report(self, report: dict) -> None:
         from fruitimpact.app.recording import _json_row
@@ -290,6 +294,7 @@ class Monitor:
         figures = {"samples": fed, "signal_seconds": fed / self.rate, "elapsed": elapsed, "lag": self._lag,
                    "dropped": self._dropped, "finished": finished,
                    "latency_p50": _percentile(latencies, 50), "latency_p99": _percentile(latencies, 99)}
+        curves = {lane: self._curve(*latest) for lane, latest in curves.items()}
         return {"type": "frame", "reports": reports, "curves": curves, "messages": messages, "figures": figures}
 
 
