@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import shlex
 
+from fruitimpact.app import inputs
 from fruitimpact.impact.quantities import GROUP_DEFAULTS, INPUTS, OUTPUTS, option_of
 from fruitimpact.impact.validation import InputError
 from fruitimpact.physics.constants import STANDARD_GRAVITY
@@ -30,18 +31,7 @@ CURVE_POINTS = 401
 
 def read_request(request) -> dict:
     """The inputs of an explorer request: names checked, empty texts dropped, values as typed."""
-    if not isinstance(request, dict):
-        raise InputError("the request must be a JSON object of inputs", "request")
-    inputs = {}
-    for name, value in request.items():
-        if name not in EXPLORER_INPUTS:
-            raise InputError(f"unknown input {name!r} (inputs: {', '.join(EXPLORER_INPUTS)})", name)
-        if value is None or (isinstance(value, str) and not value.strip()):
-            continue
-        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
-            raise InputError(f"{name} must be a number or a text; got {value!r}", name)
-        inputs[name] = value.strip() if isinstance(value, str) else value
-    return inputs
+    return inputs.read_request(request, EXPLORER_INPUTS)
 
 
 def command(inputs: dict, program: str = "simulate") -> str:

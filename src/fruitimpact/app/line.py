@@ -23,6 +23,7 @@ import json
 import math
 import shlex
 
+from fruitimpact.app.inputs import typed_value
 from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_LINE_FRUIT, MAX_POINTS, TransferPoint,
                                        _checked_point, _distinct)
 from fruitimpact.impact.outputs import dump_json
@@ -165,14 +166,8 @@ def line_csv(rows: list[dict]) -> str:
 def _lot_inputs(request: dict) -> dict:
     """The lot's inputs given (``LOT_INPUTS``), values as typed: an empty text is "not given", the fruit then
     :data:`DEFAULT_FRUIT`, and ``criterion`` ``preset`` is the fruit's own, as when it is not given."""
-    inputs = {}
-    for name in LOT_INPUTS:
-        value = request.get(name)
-        if value is None or (isinstance(value, str) and not value.strip()):
-            continue
-        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
-            raise InputError(f"{name} must be a number or a text; got {value!r}", name)
-        inputs[name] = value.strip() if isinstance(value, str) else value
+    inputs = {name: typed_value(name, request.get(name)) for name in LOT_INPUTS}
+    inputs = {name: value for name, value in inputs.items() if value is not None}
     inputs.setdefault("fruit", DEFAULT_FRUIT)
     if inputs.get("criterion") == "preset":
         del inputs["criterion"]

@@ -20,6 +20,7 @@ from collections import OrderedDict
 
 import numpy as np
 
+from fruitimpact.app import inputs
 from fruitimpact.impact.validation import InputError
 from fruitimpact.signals.options import ANALYSIS_OPTIONS
 
@@ -69,24 +70,7 @@ ANALYSES = _Analyses()
 
 def read_request(request, names=RECORDING_INPUTS) -> dict:
     """The inputs of a request: names checked, empty texts and false flags dropped, values as typed."""
-    if not isinstance(request, dict):
-        raise InputError("the request must be a JSON object of inputs", "request")
-    inputs = {}
-    for name, value in request.items():
-        if name not in names:
-            raise InputError(f"unknown input {name!r} (inputs: {', '.join(names)})", name)
-        if name in _FLAGS:
-            if not isinstance(value, bool):
-                raise InputError(f"{name} must be true or false; got {value!r}", name)
-            if value:
-                inputs[name] = True
-            continue
-        if value is None or (isinstance(value, str) and not value.strip()):
-            continue
-        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
-            raise InputError(f"{name} must be a number or a text; got {value!r}", name)
-        inputs[name] = value.strip() if isinstance(value, str) else value
-    return inputs
+    return inputs.read_request(request, names, _FLAGS)
 
 
 _OPTION_NAMES = {option: name for name, option in ANALYSIS_OPTIONS.items()}

@@ -12,7 +12,6 @@ window.fruitimpact = {updates: 0, latency: null, last: null};
 
 const heightOf = (position) => HEIGHT_MIN * Math.pow(HEIGHT_MAX / HEIGHT_MIN, position / 1000);
 const positionOf = (height) => 1000 * Math.log(height / HEIGHT_MIN) / Math.log(HEIGHT_MAX / HEIGHT_MIN);
-const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
 // a length in the unit that suits it, to 3 digits (rounded first: 0.99999 m is "1 m", not "100 cm")
 const lengthText = (h) => {
   const r = Number(h.toPrecision(3));
@@ -225,14 +224,6 @@ async function risk() {
     button.disabled = false;
     button.textContent = "compute (height × surface)";
   }
-}
-
-function download(name, blob) {
-  const link = Object.assign(document.createElement("a"), {href: URL.createObjectURL(blob), download: name});
-  document.body.appendChild(link);
-  link.click();
-  link.remove();
-  setTimeout(() => URL.revokeObjectURL(link.href), 1000);
 }
 
 async function exportAs(kind) {

@@ -12,7 +12,6 @@ let choices = null, last = null, timer = null, inFlight = false, pending = false
 // What a test or a curious user can read: answers drawn, the last one's latency [ms] (edit → page drawn), the answer.
 window.fruitimpact = {updates: 0, refusals: 0, latency: null, last: null};
 
-const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
 const percent = (share) => share === null || share === undefined ? "–" : `${fmt(share * 100, 3)} %`;
 const mm3 = (volume) => volume === null || volume === undefined ? "–" : `${fmt(volume * 1e9, 4)} mm³`;
 const points = (share) => `${fmt(Math.abs(share * 100), 3)} point${Math.abs(share * 100) === 1 ? "" : "s"}`;
@@ -368,14 +367,6 @@ function renderChanges(answer) {
 }
 
 // -------------------------------------------------------------------------------------------------- export
-function download(name, blob) {
-  const link = make("a", {href: URL.createObjectURL(blob), download: name});
-  document.body.appendChild(link);
-  link.click();
-  link.remove();
-  setTimeout(() => URL.revokeObjectURL(link.href), 1000);
-}
-
 const csvField = (value) => {
   const text = value === null || value === undefined ? "" : String(value);
   return /[",\n]/.test(text) ? `"${text.replace(/"/g, '""')}"` : text;

@@ -13,8 +13,6 @@ let socket = null, upload = null, lanes = {}, state = null, limit = 200 * 1024 *
 // What a test or a curious user can read: every count the page shows, and the stream's own summary.
 window.fruitimpact = {contacts: 0, fruit: 0, summaries: [], ended: false, started: null, frames: 0};
 
-const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
-const mb = (bytes) => `${(bytes / 1048576).toLocaleString("en-US", {maximumFractionDigits: 1})} MB`;
 const source = () => form.querySelector("input[name=source]:checked").value;
 
 function inputs() {
@@ -30,26 +28,10 @@ function inputs() {
   return out;
 }
 
-function clearErrors() {
-  for (const node of form.querySelectorAll(".field-error")) node.remove();
-  for (const node of form.querySelectorAll(".invalid")) node.classList.remove("invalid");
-  document.getElementById("form-error").hidden = true;
-}
+const clearErrors = () => clearFormErrors(form);
 
 function refuse(body) {
-  clearErrors();
-  const control = body.argument === "file" ? document.getElementById("file") : form.querySelector(`[data-input="${body.argument}"]`);
-  if (control && !control.closest("[hidden]")) {
-    control.classList.add("invalid");
-    const line = document.createElement("p");
-    line.className = "field-error";
-    line.textContent = body.error;
-    control.closest("label").after(line);
-  } else {
-    const line = document.getElementById("form-error");
-    line.textContent = body.error;
-    line.hidden = false;
-  }
+  showRefusal(form, body);
   statusLine.textContent = "refused: see the form";
   setRunning(false);
 }
@@ -62,11 +44,9 @@ function setRunning(running) {
 async function sendFile(file) {
   clearErrors();
   upload = null;
-  if (file.size > limit) return refuse({error: `file ${JSON.stringify(file.name)} is ${mb(file.size)}: the upload limit is ${mb(limit)}`, argument: "file"});
   statusLine.textContent = `uploading ${file.name}…`;
-  const response = await fetch(`/api/upload?name=${encodeURIComponent(file.name)}`, {method: "POST", body: file, headers: {"Content-Type": "application/octet-stream"}});
-  const answer = await response.json();
-  if (!response.ok || answer.refused) return refuse({error: answer.error, argument: "file"});
+  const answer = await uploadFile(file, limit);
+  if (answer.refused) return refuse(answer);
   upload = answer;
   statusLine.textContent = `${answer.file} ready to replay`;
 }
@@ -241,9 +221,4 @@ document.getElementById("file").addEventListener("change", (event) => { if (even
 document.getElementById("start").addEventListener("click", start);
 document.getElementById("stop").addEventListener("click", stop);
 form.addEventListener("submit", (event) => event.preventDefault());
-fetch("/api/options").then((r) => r.json()).then((options) => {
-  if (options.upload_limit) {
-    limit = options.upload_limit;
-    document.getElementById("upload-limit").textContent = mb(limit);
-  }
-});
+uploadLimit("upload-limit").then((bytes) => { limit = bytes; });

@@ -12,8 +12,6 @@ let upload = null, last = null, selected = null, sequence = 0, timer = null, lim
 // What a test or a curious user can read: analyses done, the last answer, the impact drawn.
 window.fruitimpact = {analyses: 0, last: null, impact: null};
 
-const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
-const mb = (bytes) => `${(bytes / 1048576).toLocaleString("en-US", {maximumFractionDigits: 1})} MB`;
 
 // The table's columns: key, heading, scale to the unit shown.
 const COLUMNS = [
@@ -34,46 +32,27 @@ function inputs() {
   return out;
 }
 
-function clearErrors() {
-  for (const node of form.querySelectorAll(".field-error")) node.remove();
-  for (const node of form.querySelectorAll(".invalid")) node.classList.remove("invalid");
-  document.getElementById("form-error").hidden = true;
-}
+const clearErrors = () => clearFormErrors(form);
 
-// A refusal: the CLI's line next to the control it names (or under the form), the last results kept, pale.
+// A refusal: the CLI's line next to its control, the last results kept, pale.
 function refuse(body) {
-  clearErrors();
-  const name = Array.isArray(body.argument) ? body.argument[0] : body.argument;
-  const control = name === "file" ? document.getElementById("file") : form.querySelector(`[data-input="${name}"]`);
-  if (control) {
-    control.classList.add("invalid");
-    const line = document.createElement("p");
-    line.className = "field-error";
-    line.textContent = body.error;
-    control.closest("label").after(line);
-  } else {
-    const line = document.getElementById("form-error");
-    line.textContent = body.error;
-    line.hidden = false;
-  }
+  showRefusal(form, body);
   results.classList.toggle("stale", last !== null);
   statusLine.textContent = "refused: see the form";
 }
 
-async function post(path, body, raw) {
-  const response = await fetch(path, raw ? {method: "POST", body: raw, headers: {"Content-Type": "application/octet-stream"}}
-                                          : {method: "POST", body: JSON.stringify(body), headers: {"Content-Type": "application/json"}});
+async function post(path, body) {
+  const response = await fetch(path, {method: "POST", body: JSON.stringify(body), headers: {"Content-Type": "application/json"}});
   const answer = await response.json();
-  if (!response.ok) return {refused: true, error: answer.error || `the server answered ${response.status}`, argument: "file"};
+  if (!response.ok) return {refused: true, error: answer.error || `the server answered ${response.status}`, argument: null};
   return answer;
 }
 
 async function send(file) {
   clearErrors();
   upload = null;
-  if (file.size > limit) return refuse({error: `file ${JSON.stringify(file.name)} is ${mb(file.size)}: the upload limit is ${mb(limit)}; analyse it with \`fruitimpact analyze\` instead`, argument: "file"});
   statusLine.textContent = `uploading ${file.name} (${mb(file.size)})…`;
-  const answer = await post(`/api/upload?name=${encodeURIComponent(file.name)}`, null, file);
+  const answer = await uploadFile(file, limit);
   if (answer.refused) return refuse(answer);
   upload = answer;
   analyse();
@@ -223,15 +202,6 @@ async function show(index) {
   window.fruitimpact.impact = answer;
 }
 
-function download(name, type, text) {
-  const link = document.createElement("a");
-  link.href = URL.createObjectURL(new Blob([text], {type}));
-  link.download = name;
-  document.body.appendChild(link);
-  link.click();
-  link.remove();
-}
-
 function csv(a) {
   const keys = a.columns;
   const quote = (v) => v === null || v === undefined ? "" : typeof v === "string" && /[",\n]/.test(v) ? `"${v.replace(/"/g, '""')}"` : typeof v === "object" ? `"${JSON.stringify(v).replace(/"/g, '""')}"` : String(v);
@@ -242,9 +212,9 @@ document.querySelector(".export").addEventListener("click", (event) => {
   const kind = event.target.dataset && event.target.dataset.export;
   if (!kind || !last) return;
   const stem = last.file.replace(/\.[^.]*$/, "");
-  if (kind === "csv") download(`${stem}-impacts.csv`, "text/csv", csv(last));
-  if (kind === "json") download(`${stem}-impacts.jsonl`, "application/json", last.impacts.map((row) => JSON.stringify(row)).join("\n") + "\n");
-  if (kind === "svg") for (const id of ["chart-overview", "chart-histogram", "chart-impact"]) download(`${stem}-${id.slice(6)}.svg`, "image/svg+xml", Charts.serialize(document.getElementById(id)));
+  if (kind === "csv") download(`${stem}-impacts.csv`, new Blob([csv(last)], {type: "text/csv"}));
+  if (kind === "json") download(`${stem}-impacts.jsonl`, new Blob([last.impacts.map((row) => JSON.stringify(row)).join("\n") + "\n"], {type: "application/json"}));
+  if (kind === "svg") for (const id of ["chart-overview", "chart-histogram", "chart-impact"]) download(`${stem}-${id.slice(6)}.svg`, new Blob([Charts.serialize(document.getElementById(id))], {type: "image/svg+xml"}));
 });
 
 document.querySelector("#impacts tbody").addEventListener("click", (event) => {
@@ -264,9 +234,4 @@ form.addEventListener("input", (event) => {
 });
 form.addEventListener("submit", (event) => event.preventDefault());
 
-fetch("/api/options").then((r) => r.json()).then((options) => {
-  if (options.upload_limit) {
-    limit = options.upload_limit;
-    document.getElementById("upload-limit").textContent = mb(limit);
-  }
-});
+uploadLimit("upload-limit").then((bytes) => { limit = bytes; });
