@@ -9,6 +9,7 @@ Playwright is missing; ``.ci/run`` sets FRUITIMPACT_BROWSER_TESTS=required and i
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -150,6 +151,29 @@ def _browser():
     return playwright
 
 
+@contextlib.contextmanager
+def browser_page(server: str):
+    """A page of Debian's Chromium (1400 × 1000, downloads accepted) that fails the test, once closed, on any
+    console error, any script error and any request to a host other than the server (the app must work
+    offline)."""
+    playwright = _browser()
+    problems, foreign = [], []
+    local = (server, server.replace("http://", "ws://"), "data:", "blob:")
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
+        page.on("console", lambda message: problems.append(message.text) if message.type == "error" else None)
+        page.on("pageerror", lambda error: problems.append(str(error)))
+        page.on("request", lambda request: foreign.append(request.url)
+                if not request.url.startswith(local) else None)
+        try:
+            yield page
+        finally:
+            browser.close()
+    assert not foreign, foreign
+    assert not problems, problems
+
+
 def _wait(page, expression: str, timeout: float = 30.0):
     """Poll a JavaScript expression (page.wait_for_function evaluates strings, which the page's CSP forbids)."""
     end = time.monotonic() + timeout
@@ -165,15 +189,7 @@ def _cell(page, name: str) -> float:
 
 
 def test_the_explorer_in_a_real_browser(server, tmp_path):
-    playwright = _browser()
-    problems, foreign = [], []
-    with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        page = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
-        page.on("console", lambda message: problems.append(message.text) if message.type == "error" else None)
-        page.on("pageerror", lambda error: problems.append(str(error)))
-        page.on("request", lambda request: foreign.append(request.url)
-                if not request.url.startswith((server, "data:", "blob:")) else None)
+    with browser_page(server) as page:
         page.goto(server)
         _wait(page, "window.fruitimpact.updates >= 1")
         # opens on `fruitimpact simulate`'s impact: the numbers are the library's (5 significant digits shown)
@@ -223,6 +239,3 @@ def test_the_explorer_in_a_real_browser(server, tmp_path):
         lines = (download.value.path().read_text() if hasattr(download.value.path(), "read_text")
                  else open(download.value.path()).read()).splitlines()
         assert lines[0] == "time_s,deflection_m,force_N" and len(lines) > 100
-        browser.close()
-    assert not foreign, foreign
-    assert not problems, problems

@@ -20,7 +20,7 @@ import pytest
 import fruitimpact as fi
 from fruitimpact.handling.line import TransferPoint, read_line
 from fruitimpact.impact.outputs import dump_json
-from test_app import CHROMIUM, _browser, _post, _wait, server  # noqa: F401 - server is a fixture
+from test_app import _post, _wait, browser_page, server  # noqa: F401 - server is a fixture
 
 pytest.importorskip("tornado")
 from fruitimpact.app import line as page  # noqa: E402 - the app needs tornado's extra
@@ -226,15 +226,7 @@ def _shown(page_, row: int, column: str) -> float:
 
 
 def test_the_line_audit_in_a_real_browser(server, tmp_path):
-    playwright = _browser()
-    problems, foreign = [], []
-    with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        view = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
-        view.on("console", lambda message: problems.append(message.text) if message.type == "error" else None)
-        view.on("pageerror", lambda error: problems.append(str(error)))
-        view.on("request", lambda request: foreign.append(request.url)
-                if not request.url.startswith((server, "data:", "blob:")) else None)
+    with browser_page(server) as view:
         view.goto(server + "line")
         _wait(view, "window.fruitimpact.updates >= 1")
         # opens on the example line: its numbers are audit_line's (shown to 3 significant digits for a share, 4 for
@@ -318,6 +310,4 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
             view.click("[data-export=line]")
         assert download.value.suggested_filename == "line.csv"
         assert read_line(download.value.path()) == _points(line)
-        browser.close()
-    assert not foreign, foreign
-    assert not problems, problems
+

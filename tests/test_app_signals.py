@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 import fruitimpact as fi
-from test_app import CHROMIUM, _browser, _post, _wait, server  # noqa: F401 - the server fixture
+from test_app import _post, _wait, browser_page, server  # noqa: F401 - the server fixture
 
 pytest.importorskip("tornado")
 RATE = 20_000.0
@@ -300,21 +300,9 @@ def test_a_monitor_refuses_what_stream_refuses(server):
 
 # --------------------------------------------------------------------------- in a real browser
 
-def _watch(page, server, problems, foreign):
-    page.on("console", lambda message: problems.append(message.text) if message.type == "error" else None)
-    page.on("pageerror", lambda error: problems.append(str(error)))
-    page.on("request", lambda request: foreign.append(request.url)
-            if not request.url.startswith((server, server.replace("http://", "ws://"), "data:", "blob:")) else None)
-
-
 def test_the_recording_page_in_a_real_browser(server, line_recording):
     path, _ = line_recording
-    playwright = _browser()
-    problems, foreign = [], []
-    with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
-        _watch(page, server, problems, foreign)
+    with browser_page(server) as page:
         page.goto(server + "recording")
         page.fill("input[name=rate]", "20kHz")
         page.fill("input[name=lanes]", "4")
@@ -335,19 +323,11 @@ def test_the_recording_page_in_a_real_browser(server, line_recording):
         page.wait_for_selector(".field-error")
         assert "argument --hum" in page.text_content(".field-error")
         assert "stale" in page.get_attribute("#results", "class")
-        browser.close()
-    assert not foreign, foreign
-    assert not problems, problems
 
 
 def test_the_monitor_in_a_real_browser_keeps_up_with_four_lanes(server, line_recording):
     path, truth = line_recording
-    playwright = _browser()
-    problems, foreign = [], []
-    with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
-        _watch(page, server, problems, foreign)
+    with browser_page(server) as page:
         page.goto(server + "monitor")
         page.set_input_files("#file", str(path))
         _wait(page, "document.querySelector('#status').textContent.includes('ready')")
@@ -364,6 +344,3 @@ def test_the_monitor_in_a_real_browser_keeps_up_with_four_lanes(server, line_rec
         assert int(page.text_content("#contacts").replace(",", "")) == contacts
         assert page.locator(".lane").count() == 4
         assert "(all)" in page.text_content("#messages")
-        browser.close()
-    assert not foreign, foreign
-    assert not problems, problems
