@@ -92,6 +92,7 @@ def in_browser(url: str, path: Path, speeds, screenshots: Path | None) -> list[d
         browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
         page = browser.new_page(viewport={"width": 1400, "height": 1000})
         page.goto(url + "monitor")
+        page.check("input[name=fit]")
         page.set_input_files("#file", str(path))
         wait(page, "document.querySelector('#status').textContent.includes('ready')")
         page.fill("input[name=rate]", OPTIONS["rate"])
@@ -114,6 +115,7 @@ def in_browser(url: str, path: Path, speeds, screenshots: Path | None) -> list[d
             rows.append({"speed": speed, "wall": wall, **state, "clock": figures[0], "latency": figures[1]})
         if screenshots:
             page.goto(url + "recording")
+            page.check("input[name=fit]")
             page.fill("input[name=rate]", OPTIONS["rate"])
             page.fill("input[name=lanes]", OPTIONS["lanes"])
             page.fill("input[name=drop_height]", OPTIONS["drop_height"])

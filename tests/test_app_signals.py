@@ -223,9 +223,10 @@ def test_the_upload_folder_goes_with_the_server():
 
 # --------------------------------------------------------------------------- the monitor's channel
 
-async def _monitor(server: str, start: dict, feed=None, timeout: float = 120.0) -> dict:
+async def _monitor(server: str, start: dict, feed=None, timeout: float = 120.0, summaries: int = 1) -> dict:
     """Run one monitor over the WebSocket; ``feed(started)`` (in a thread) sends samples for a tcp source.
-    Returns the started message, every report, every source message and the last figures."""
+    Stops the monitor once ``summaries`` clients were summed up.  Returns the started message, every report,
+    every source message and the last figures."""
     import tornado.websocket
 
     url = server.replace("http://", "ws://") + "ws/monitor"
@@ -246,7 +247,7 @@ async def _monitor(server: str, start: dict, feed=None, timeout: float = 120.0) 
             reports += message["reports"]
             messages += message["messages"]
             figures = message["figures"]
-            if feed and any(m["type"] == "summary" for m in messages):
+            if feed and sum(m["type"] == "summary" for m in messages) >= summaries:
                 await socket_.write_message(json.dumps({"action": "stop"}))
     if feeding:
         await feeding
@@ -304,6 +305,7 @@ def test_the_recording_page_in_a_real_browser(server, line_recording):
     path, _ = line_recording
     with browser_page(server) as page:
         page.goto(server + "recording")
+        page.check("input[name=fit]")  # off by default: the fit needs the drop height or the mass
         page.fill("input[name=rate]", "20kHz")
         page.fill("input[name=lanes]", "4")
         page.fill("input[name=drop_height]", "5cm")
@@ -344,3 +346,65 @@ def test_the_monitor_in_a_real_browser_keeps_up_with_four_lanes(server, line_rec
         assert int(page.text_content("#contacts").replace(",", "")) == contacts
         assert page.locator(".lane").count() == 4
         assert "(all)" in page.text_content("#messages")
+
+
+def test_a_reset_connection_ends_one_client_and_the_monitor_takes_the_next(server):
+    # an acquisition that reconnects after a network glitch loses only what was in flight (stream --listen
+    # does the same); the reset used to kill the monitor's thread, and the next client was refused
+    import struct
+
+    def send(started):
+        for attempt in range(2):
+            connection = socket.create_connection(("127.0.0.1", started["port"]), timeout=30)
+            connection.sendall(b"1.0\n" * 100 + (b"0.5\n" * 100 if attempt else b""))
+            if attempt == 0:  # a reset, not a close: SO_LINGER 0
+                connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+            connection.close()
+            time.sleep(0.5)
+
+    run = asyncio.run(_monitor(server, {"source": "tcp", "rate": "20kHz", "port": "0"}, send, timeout=60,
+                               summaries=2))
+    summaries = [m["summary"] for m in run["messages"] if m["type"] == "summary"]
+    assert [s["samples"] for s in summaries][-1] == 200 and len(summaries) == 2
+    clients = [m for m in run["messages"] if m["type"] == "client"]
+    assert len(clients) == 2
+
+
+def test_a_cut_float32_sample_is_counted_as_dropped(server):
+    def send(started):
+        with socket.create_connection(("127.0.0.1", started["port"]), timeout=30) as connection:
+            connection.sendall(np.zeros(4 * 100, dtype="<f4").tobytes() + b"\x00\x00\x00")
+
+    run = asyncio.run(_monitor(server, {"source": "tcp", "rate": "20kHz", "lanes": "4", "format": "f32",
+                                        "port": "0"}, send))
+    summaries = [m["summary"] for m in run["messages"] if m["type"] == "summary"]
+    assert summaries[0]["dropped_bytes"] == 3 and run["figures"]["dropped"] == 1
+
+
+def test_an_option_refused_on_the_page_is_the_clis_line_once(server, line_recording):
+    path, _ = line_recording
+    _, stored = _upload(server, path.name, path.read_bytes())
+    _, body = _post(server + "api/recording", {"upload": stored["upload"], "rate": "20kHz", "lanes": "4",
+                                               "drop_height": "-5cm"})
+    from conftest import console_script
+
+    cli = subprocess.run([console_script(), "analyze", str(path), "--rate", "20kHz", "--lanes", "4",
+                          "--drop-height", "-5cm"], capture_output=True, text=True, timeout=120)
+    assert body["error"] == cli.stderr.strip().removeprefix("fruitimpact analyze: error: ")
+    assert body["error"].count("argument --drop-height") == 1 and body["argument"] == "drop_height"
+    # the fit without a drop height or a mass: said next to the drop height
+    _, body = _post(server + "api/recording", {"upload": stored["upload"], "rate": "20kHz", "lanes": "4",
+                                               "fit": True})
+    assert body["refused"] and body["argument"] == "drop_height"
+
+
+def test_stream_listen_on_a_port_in_use_is_one_line():
+    from conftest import console_script
+
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        done = subprocess.run([console_script(), "stream", "--rate", "20kHz", "--listen", str(port)],
+                              capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr.strip().startswith(f"fruitimpact stream: error: argument --listen: cannot listen on "
+                                          f"127.0.0.1:{port}:")

@@ -107,6 +107,7 @@ class Monitor:
         self._messages: list[dict] = []  # source events for the page (a client connected, a summary)
         self._arrivals: deque = deque()  # (samples fed after a chunk, wall time it arrived)
         self._fed = 0
+        self._fed_sent = -1  # samples fed when the last frame went
         self._started = None
         self._lag = 0.0
         self._dropped = 0
@@ -204,6 +205,10 @@ class Monitor:
                             data = connection.recv(CHUNK_SIZE)
                         except TimeoutError:
                             continue
+                        except OSError as error:  # a reset: this client's stream ends, the next one is taken
+                            self._message({"type": "problem", "message": f"client {self._clients}: the connection "
+                                           f"was lost ({error.strerror or error}); its contacts so far are kept"})
+                            break
                         if not data:
                             break
                         arrived = time.monotonic()
@@ -227,8 +232,8 @@ class Monitor:
         analyzer.close()
         summary = analyzer.summary()
         source = analyzer.source
-        self._dropped = int(getattr(source, "malformed", 0)) + int(getattr(source, "dropped_bytes", 0)) // (
-            4 * len(self.lane_names))
+        cut = int(getattr(source, "dropped_bytes", 0))  # the bytes of a cut sample: one sample dropped
+        self._dropped = int(getattr(source, "malformed", 0)) + -(-cut // (4 * len(self.lane_names)))
         self._message({"type": "summary", "summary": summary, "dropped": self._dropped})
 
     # ------------------------------------------------------------------ reports
@@ -288,8 +293,9 @@ class Monitor:
             messages, self._messages = self._messages, []
             latencies = self._latencies[-2000:]
             fed = self._fed
-        if not (reports or curves or messages) and finished:
-            return None
+        if not (reports or curves or messages) and (finished or fed == self._fed_sent):
+            return None  # no news: no frame (an idle tcp source between clients sends nothing)
+        self._fed_sent = fed
         elapsed = time.monotonic() - self._started
         figures = {"samples": fed, "signal_seconds": fed / self.rate, "elapsed": elapsed, "lag": self._lag,
                    "dropped": self._dropped, "finished": finished,

@@ -13,6 +13,7 @@ reason, anything unexpected with status 500 and one line; the server goes on.
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import functools
 import json
 import signal
@@ -36,6 +37,8 @@ from fruitimpact.impact.validation import usage_message
 #: beyond it tornado closes the connection without reading it.
 MAX_REQUEST = 64 * 1024
 MAX_BODY = 1024 * 1024
+#: Workers of the long computations (line audits, recordings), apart from the quick ones.
+HEAVY_WORKERS = 2
 #: No script, style, font or image from any other origin.
 SECURITY_POLICY = ("default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
                    "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
@@ -72,8 +75,9 @@ class StaticHandler(_Secure, tornado.web.StaticFileHandler):
 class ApiHandler(_Secure, tornado.web.RequestHandler):
     """A JSON call: the body is a JSON object, the answer a JSON object; errors as described in the module."""
 
-    def initialize(self, compute, method: str = "POST"):
+    def initialize(self, compute, method: str = "POST", pool=None):
         self.compute = compute
+        self.pool = pool  # None: asyncio's default pool (the quick routes)
         self.SUPPORTED_METHODS = (method,)  # the other answered 405 by tornado (as JSON: write_error)
 
     def _answer(self, status: int, body: dict) -> None:
@@ -99,16 +103,16 @@ class ApiHandler(_Secure, tornado.web.RequestHandler):
         await self._run((request,))
 
     async def _run(self, arguments=()):
-        await _answered(self, self.compute, *arguments)
+        await _answered(self, self.compute, *arguments, pool=self.pool)
 
 
-async def _answered(handler, compute, *arguments) -> None:
+async def _answered(handler, compute, *arguments, pool=None) -> None:
     """Run ``compute(*arguments)`` in a worker thread and answer its result, or its refusal: the library's
     ``InputError`` is answered 200 ``refused``, with the CLI's line and the input it names (the request was read
     and judged: a browser logs every 4xx as a console error, and 4xx stays for requests that cannot be read at
     all); anything else 500 with one line, and the server goes on."""
     try:
-        result = await asyncio.get_running_loop().run_in_executor(None, compute, *arguments)
+        result = await asyncio.get_running_loop().run_in_executor(pool, compute, *arguments)
     except ValueError as error:
         argument = getattr(error, "argument", None)
         return handler._answer(200, {"refused": True, "error": usage_message(error),
@@ -255,16 +259,20 @@ def make_app(uploads: UploadStore | None = None) -> tornado.web.Application:
     """The tornado application: the pages, ``/static/``, the JSON API under ``/api/`` and the uploads (kept in
     ``uploads``, a new store when None; the caller closes it)."""
     uploads = uploads if uploads is not None else UploadStore()
+    # line audits and recordings take seconds to minutes: their own two workers, so that they queue among
+    # themselves and never hold up the explorer's and the impact view's answers (asyncio's default pool)
+    heavy = concurrent.futures.ThreadPoolExecutor(HEAVY_WORKERS, thread_name_prefix="fruitimpact-heavy")
     routes = [(path, PageHandler, {"page": page}) for path, (_, page) in PAGES.items()]
     routes += [
         (r"/api/upload", UploadHandler, {"uploads": uploads}),
-        (r"/api/recording", ApiHandler, {"compute": functools.partial(recording.analyze, uploads=uploads)}),
+        (r"/api/recording", ApiHandler, {"compute": functools.partial(recording.analyze, uploads=uploads),
+                                         "pool": heavy}),
         (r"/api/impact", ApiHandler, {"compute": recording.impact}),
         (r"/ws/monitor", MonitorSocket, {"uploads": uploads}),
         (r"/api/options", ApiHandler, {"compute": explorer.options, "method": "GET"}),
         (r"/api/explore", ApiHandler, {"compute": explorer.explore}),
         (r"/api/risk", ApiHandler, {"compute": explorer.risk}),
-        (r"/api/line", ApiHandler, {"compute": line.audit}),
+        (r"/api/line", ApiHandler, {"compute": line.audit, "pool": heavy}),
         (r"/static/(.*)", StaticHandler, {"path": _static()}),
     ]
     return tornado.web.Application(routes, compress_response=True, max_body_size=MAX_BODY,

@@ -409,8 +409,12 @@ def cmd_stream(args) -> int:
         def listening(actual):
             print(f"{PROG} stream: listening on 127.0.0.1:{actual}", file=sys.stderr, flush=True)
 
-        _library_call(serve, port, rate, lanes, settings, emit, source=source, on_problem=problem,
-                      on_listening=listening, analysis=analysis)
+        try:
+            _library_call(serve, port, rate, lanes, settings, emit, source=source, on_problem=problem,
+                          on_listening=listening, analysis=analysis)
+        except OSError as error:  # the port taken, or not ours to bind
+            raise UsageError(f"argument --listen: cannot listen on 127.0.0.1:{port}: "
+                             f"{error.strerror or error}") from None
         return 0
     analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, emit, source=source, on_problem=problem,
                              analysis=analysis)

@@ -310,6 +310,8 @@ def usage_message(exc: ValueError) -> str:
         return conflict_message([option_of(name) for name in argument])
     if isinstance(argument, str) and (argument in INPUTS or argument in COMMAND_ARGUMENTS):
         text = str(exc)
+        if text.startswith("argument "):  # worded by the option already (the analysis options)
+            return text
         text = text[len(argument) + 2:] if text.startswith(argument + ": ") else text
         return f"argument {COMMAND_ARGUMENTS.get(argument) or option_of(argument)}: {text}"
     return str(exc)

@@ -37,6 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fruitimpact.impact.validation import InputError
+
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
@@ -92,8 +94,8 @@ class Analysis:
 
     def __post_init__(self):
         if self.fit and (self.velocity is None) == (self.mass is None):
-            raise ValueError("the fit needs exactly one of the impact velocity (--velocity or --drop-height) and "
-                             "the mass (--mass): one pulse determines three of k_c, c, m, V")
+            raise InputError("the fit needs exactly one of the impact velocity (--velocity or --drop-height) and "
+                             "the mass (--mass): one pulse determines three of k_c, c, m, V", "drop_height")
         if (self.diameter is None) != (self.poisson is None):
             raise ValueError("give both --diameter and --poisson (the modulus follows from k_c with both)")
         if self.classes is not None and self.classes.by in ("modulus", "stiffness") and not self.fit:

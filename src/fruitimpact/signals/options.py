@@ -42,6 +42,8 @@ _SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hu
 
 def _setting_error(exc: ValueError) -> InputError:
     """The library's error about a setting, prefixed with the option the user gave it by."""
+    if isinstance(exc, InputError) and exc.argument is not None:
+        return exc  # it names its input already
     text = str(exc)
     option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
     return InputError(f"argument {option}: {text}" if option else text)

@@ -32,6 +32,7 @@ const clearErrors = () => clearFormErrors(form);
 
 function refuse(body) {
   showRefusal(form, body);
+  document.getElementById("results").classList.add("stale");  // the figures are the last run's
   statusLine.textContent = "refused: see the form";
   setRunning(false);
 }
@@ -95,6 +96,7 @@ function receive(message) {
 }
 
 function started(message) {
+  document.getElementById("results").classList.remove("stale");
   window.fruitimpact.started = message;
   state.classes = message.classes;
   document.getElementById("state").textContent = "running";

@@ -38,6 +38,7 @@ const clearErrors = () => clearFormErrors(form);
 function refuse(body) {
   showRefusal(form, body);
   results.classList.toggle("stale", last !== null);
+  if (last === null) document.getElementById("summary").textContent = "Refused: the reason is next to its control on the left.";
   statusLine.textContent = "refused: see the form";
 }
 
