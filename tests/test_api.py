@@ -421,3 +421,25 @@ def test_inputs_that_would_override_a_map_or_a_line_are_refused(call, match):
     silently replace the value each column or point names; a misspelt fruit is named as such."""
     with pytest.raises(ValueError, match=match):
         call()
+
+
+@pytest.mark.parametrize("call", [lambda: fi.simulate(velocity=10 ** 400), lambda: fi.drop(10 ** 400),
+                                  lambda: fi.safe_height(mass=10 ** 400)])
+def test_an_integer_beyond_a_float_is_refused_not_a_crash(call):
+    # float(10**400) raises OverflowError: it used to escape as a traceback instead of the input's one line
+    with pytest.raises(ValueError, match=r"must be a number \(units allowed"):
+        call()
+
+
+def test_an_integer_beyond_a_float_is_one_invalid_row():
+    table = fi.evaluate({"velocity": [10 ** 400, 1.0]})  # a table judges per row: that row alone is refused
+    assert list(table["status"]) == ["invalid", "ok"]
+    assert table["message"][0].startswith("velocity must be a number")
+
+
+def test_a_bruise_characteristic_needs_a_criterion_before_any_work():
+    # without a criterion every row's bruise volume is NaN: a summary of it said "ok" with count 0
+    with pytest.raises(ValueError, match=r"criterion must be given for bruise_volume"):
+        fi.population(rows=5, characteristics="bruise_volume")
+    summary = fi.population(rows=5, fruit="apple", criterion="shear", characteristics="bruise_volume")
+    assert summary.to_dict()["statistics"]["bruise_volume"]["count"] == 5

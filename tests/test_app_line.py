@@ -311,3 +311,15 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
         assert download.value.suggested_filename == "line.csv"
         assert read_line(download.value.path()) == _points(line)
 
+
+
+@pytest.mark.parametrize("bruised,count", [(0, 500), (1, 500), (250, 500), (499, 500), (500, 500), (3, 7)])
+def test_the_incidence_interval_is_wilsons(bruised, count):
+    # reference: SciPy's binomial test, Wilson score interval at 95 % (an implementation not ours)
+    from scipy.stats import binomtest
+
+    from fruitimpact.app.line import wilson_interval
+
+    expected = binomtest(bruised, count).proportion_ci(confidence_level=0.95, method="wilson")
+    low, high = wilson_interval(bruised / count, count)
+    assert low == pytest.approx(expected.low, abs=1e-12) and high == pytest.approx(expected.high, abs=1e-12)

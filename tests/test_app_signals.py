@@ -48,10 +48,6 @@ def _upload(server: str, name: str, data: bytes):
     return _post(url, None, raw=data)
 
 
-def _analysis_rows(body) -> list:
-    return body["impacts"]
-
-
 def _same(page_rows: list, frame) -> None:
     """The page's rows are ``analyze``'s rows: every column, NaN shown as null."""
     assert len(page_rows) == len(frame)
@@ -79,6 +75,13 @@ def test_an_uploaded_recording_is_analysed_as_analyze_does(server, line_recordin
     expected = fi.analyze(path, rate=RATE, lanes=4, hum="50Hz", fit=True, drop_height="5cm",
                           sort_by="firmness_c_star", thresholds="1e7,2e7")
     _same(body["impacts"], expected)
+    # and true to the generator's own contacts (not only to analyze): none invented, the peak forces within the
+    # 1 % of issue 13's goal; recall 0.99 here, the 2 contacts missed of 200 lie inside overlaps (issue 13's open
+    # work), hence 0.98 and not 1
+    import linegen
+
+    card = linegen.score(body["impacts"], truth)
+    assert card["extra"] == 0 and card["recall"] >= 0.98 and card["peak_force_p95"] <= 0.01, card
     assert body["command"] == (f"fruitimpact analyze {path.name} --rate 20kHz --lanes 4 --hum 50Hz --fit "
                                "--drop-height 5cm --sort-by firmness_c_star --thresholds 1e7,2e7")
     # the histogram counts the fruit (first contacts), the classes sum to them
@@ -97,11 +100,14 @@ def test_an_uploaded_recording_is_analysed_as_analyze_does(server, line_recordin
     index = next(i for i, row in enumerate(body["impacts"]) if row["fit_converged"] and not row["rebound"])
     status, shown = _post(server + "api/impact", {"analysis": body["analysis"], "index": index})
     assert status == 200 and shown["row"] == body["impacts"][index]
-    assert max(shown["force"]) == pytest.approx(shown["row"]["raw_peak_force"], rel=0.05)  # the raw samples
+    # the samples are the window the indices came from: their greatest is the raw peak plus at most the noise the
+    # detector smooths away (the generator's noise is 1 % of the median peak; 3 σ of it at a small peak ≈ 5 %)
+    assert max(shown["force"]) == pytest.approx(shown["row"]["raw_peak_force"], rel=0.05)
+    # the model drawn is the fit's own pulse: its greatest on 600 points over the window is the fitted peak force
+    # to the grid's resolution (a parabola's top sampled at spacing h: relative error ~ (π h / T)²/8 ≈ 1e-4)
     model_peak = max(shown["model"]["force"])
-    # the model's peak is the fitted peak force; the fit's relative residual is the noise, ~1 % here
-    assert model_peak == pytest.approx(shown["row"]["peak_force"], rel=0.01)
-    assert shown["row"]["fit_residual_relative"] < 0.05
+    assert model_peak == pytest.approx(shown["row"]["peak_force"], rel=1e-3)
+    assert shown["row"]["fit_residual_relative"] < 0.05  # the fit's residual is the noise, ~1 % of the peak
 
 
 def test_a_real_tdms_file_from_labview(server):
@@ -290,11 +296,14 @@ def test_the_monitor_is_the_streams_tcp_source(server, line_recording):
     assert len(run["reports"]) == len(fi.analyze(parsed, rate=RATE))
 
 
-def test_a_monitor_refuses_what_stream_refuses(server):
+def test_a_monitor_refuses_what_stream_refuses(server, line_recording):
+    uploaded = _upload(server, line_recording[0].name, line_recording[0].read_bytes())[1]["upload"]
     for start, argument in [({"source": "tcp"}, "rate"), ({"source": "tcp", "rate": "20kHz", "port": "70000"}, "port"),
                             ({"source": "replay"}, "file"), ({"source": "pipe"}, "source"),
                             ({"source": "tcp", "rate": "20kHz", "hum": "abc"}, "hum"),
-                            ({"source": "replay", "upload": "x", "speed": "3"}, "upload")]:
+                            ({"source": "replay", "upload": "x"}, "upload"),
+                            ({"source": "replay", "upload": uploaded, "speed": "3"}, "speed"),
+                            ({"source": "tcp", "rate": "20kHz", "fit": True, "velocity": "1", "mass": "0.1"}, "mass")]:
         run = asyncio.run(_monitor(server, start))
         assert run["started"]["type"] == "refused" and run["started"]["argument"] == argument, (start, run)
 
@@ -408,3 +417,36 @@ def test_stream_listen_on_a_port_in_use_is_one_line():
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert done.stderr.strip().startswith(f"fruitimpact stream: error: argument --listen: cannot listen on "
                                           f"127.0.0.1:{port}:")
+
+
+def test_a_nan_in_a_request_is_refused_on_its_control(server, line_recording):
+    # Python's JSON reader takes NaN: it reaches the inputs, where a NaN is refused, never a default
+    path, _ = line_recording
+    _, stored = _upload(server, path.name, path.read_bytes())
+    raw = ('{"upload": "%s", "rate": "20kHz", "lanes": 4, "hum": NaN}' % stored["upload"]).encode()
+    body = _post(server + "api/recording", None, raw=raw)[1]
+    assert body["refused"] and body["argument"] == "hum", body
+
+
+def test_the_upload_folder_of_a_killed_server_is_removed_by_the_next(tmp_path, monkeypatch):
+    import tempfile
+
+    from fruitimpact.app import uploads
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    dead = subprocess.Popen(["true"])
+    dead.wait()  # a process id that is gone
+    orphan = tmp_path / (uploads.PREFIX + "killed")
+    orphan.mkdir()
+    (orphan / uploads.MARKER).write_text(f"uploads of a fruitimpact serve\npid={dead.pid}\n")
+    (orphan / "0123456789abcdef.csv").write_text("time,force\n")
+    alive = tmp_path / (uploads.PREFIX + "alive")
+    alive.mkdir()
+    (alive / uploads.MARKER).write_text(f"pid={os.getpid()}\n")
+    unmarked = tmp_path / (uploads.PREFIX + "not-ours")
+    unmarked.mkdir()  # no marker: not the app's, never touched
+    store = uploads.UploadStore()
+    try:
+        assert not orphan.exists() and alive.exists() and unmarked.exists()
+    finally:
+        store.close()

@@ -380,3 +380,12 @@ def test_population_refuses_a_spread_whose_draws_overflow(name):
     # the class lookup.  Beyond 2 (a factor e² per sd) no fruit population is meant.
     with pytest.raises(ValueError, match=rf"Population.{name} must be a finite number >= 0 and <= 2"):
         Population(count=2, interval=0.1, **APPLE, velocity=1.0, restitution=E, classes=CLASSES, **{name: 6e5})
+
+
+@pytest.mark.parametrize("argv,expected", [
+    (("--seed", "x"), "argument --seed: seed must be an integer >= 0; got 'x'"),  # was "SensorModel.seed ... -1"
+    (("--rebounds", "3"), "argument --rebounds: rebounds must be an integer in [0, 2]; got '3'"),
+    (("--adc-bits", "40"), "argument --adc-bits: adc_bits must be an integer in [0, 32]; got '40'"),
+])
+def test_synth_integer_options_are_named_with_their_range(cli, tmp_path, argv, expected):
+    assert cli.error("synth", "-o", tmp_path / "r.csv", *argv) == f"fruitimpact synth: error: {expected}"

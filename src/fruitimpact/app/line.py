@@ -19,14 +19,13 @@ same rows).  Errors are the library's ``InputError``, worded by the server as th
 
 from __future__ import annotations
 
-import json
 import math
 import shlex
 
 from fruitimpact.app.inputs import typed_value
 from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_LINE_FRUIT, MAX_POINTS, TransferPoint,
                                        _checked_point, _distinct)
-from fruitimpact.impact.outputs import dump_json
+from fruitimpact.impact.outputs import json_safe
 from fruitimpact.impact.quantities import option_of
 from fruitimpact.impact.validation import InputError, read_count, usage_message
 
@@ -274,7 +273,7 @@ def audit(request) -> dict:
                             spreads=spreads, **{k: v for k, v in inputs.items() if k != "criterion"})
     except InputError as error:
         raise _at_point(error, points) from None
-    report = json.loads(dump_json(report, indent=None))  # the one strict-JSON writer: NaN and inf are null
+    report = json_safe(report)  # NaN and inf as null, as the server's JSON writer writes them
     changes = report["changes"]
     report["changes"] = [change for change in changes if change["to"] in alternatives]
     seed_text = str(report["seed"])

@@ -29,6 +29,7 @@ from collections import deque
 
 import numpy as np
 
+from fruitimpact.signals.settings import MAX_LANES
 from fruitimpact.impact.validation import InputError, check_choice, read_count
 from fruitimpact.signals.options import ANALYSIS_OPTIONS
 
@@ -42,6 +43,8 @@ SPEEDS = {"1": 1.0, "2": 2.0, "5": 5.0, "10": 10.0, "max": math.inf}
 MONITOR_INPUTS = ("source", "upload", "speed", "port", "format", "rate", "lanes", "column", *ANALYSIS_OPTIONS)
 #: Points of a lane's latest curve sent to the page (the window is decimated beyond).
 CURVE_POINTS = 400
+#: Latest report latencies the percentiles are taken over.
+LATENCIES_KEPT = 2000
 #: Seconds of arrivals kept for the latency of late reports.
 ARRIVALS_KEPT = 30.0
 
@@ -75,7 +78,7 @@ class Monitor:
             self.speed = SPEEDS[speed]
             reading = {key: inputs.pop(key) for key in ("rate", "column", "lanes") if key in inputs}
             if "lanes" in reading:
-                reading["lanes"] = read_count("lanes", reading["lanes"], 1, 64)
+                reading["lanes"] = read_count("lanes", reading["lanes"], 1, MAX_LANES)
             path = upload.checked_path()
             try:
                 self.recording = open_recording(path, **reading)
@@ -90,7 +93,7 @@ class Monitor:
             self.rate = check_rate(inputs.pop("rate", None))
             if self.rate is None:
                 raise InputError("rate is required for the tcp source (the sample rate of the stream [Hz])", "rate")
-            lanes = read_count("lanes", inputs.pop("lanes", 1), 1, 256)
+            lanes = read_count("lanes", inputs.pop("lanes", 1), 1, MAX_LANES)
             self.format = check_choice("format", inputs.pop("format", "text"), ("text", "f32"))
             self.port = read_count("port", inputs.pop("port", 0), 0, 65535)
             self.lane_names = [f"lane{k}" for k in range(lanes)]
@@ -103,7 +106,7 @@ class Monitor:
         self._stop = threading.Event()
         self._reports: list[dict] = []
         self._curves: dict[str, dict] = {}
-        self._latencies: list[float] = []
+        self._latencies: deque = deque(maxlen=LATENCIES_KEPT)  # a tcp monitor runs for days
         self._messages: list[dict] = []  # source events for the page (a client connected, a summary)
         self._arrivals: deque = deque()  # (samples fed after a chunk, wall time it arrived)
         self._fed = 0
@@ -112,7 +115,6 @@ class Monitor:
         self._lag = 0.0
         self._dropped = 0
         self._clients = 0
-        self._error: str | None = None
         self.finished = False
         self._thread: threading.Thread | None = None
         self._server: socket.socket | None = None
@@ -161,7 +163,6 @@ class Monitor:
             else:
                 self._listen()
         except ValueError as error:  # a bad row of the recording, binary on a text stream: said on the page
-            self._error = str(error)
             self._message({"type": "error", "message": str(error).replace(str(getattr(self.recording, "source", "")),
                                                                           self.file or "")})
         finally:
@@ -259,13 +260,12 @@ class Monitor:
         return curve
 
     def _report(self, report: dict) -> None:
-        from fruitimpact.app.recording import _json_row
         from fruitimpact.signals.analysis import public
 
         now = time.monotonic()
         start = report.get("raw_start_time", report.get("start_time"))
         duration = report.get("raw_contact_duration", report.get("contact_duration"))
-        row = _json_row(public(report))
+        row = public(report)
         with self._lock:
             latency = None
             if start is not None and duration is not None and math.isfinite(start + duration):
@@ -291,7 +291,7 @@ class Monitor:
             reports, self._reports = self._reports, []
             curves, self._curves = self._curves, {}
             messages, self._messages = self._messages, []
-            latencies = self._latencies[-2000:]
+            latencies = list(self._latencies)
             fed = self._fed
         if not (reports or curves or messages) and (finished or fed == self._fed_sent):
             return None  # no news: no frame (an idle tcp source between clients sends nothing)

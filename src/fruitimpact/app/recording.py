@@ -21,6 +21,7 @@ from collections import OrderedDict
 import numpy as np
 
 from fruitimpact.app import inputs
+from fruitimpact.signals.settings import MAX_LANES
 from fruitimpact.impact.validation import InputError
 from fruitimpact.signals.options import ANALYSIS_OPTIONS
 
@@ -73,21 +74,12 @@ def read_request(request, names=RECORDING_INPUTS) -> dict:
     return inputs.read_request(request, names, _FLAGS)
 
 
-_OPTION_NAMES = {option: name for name, option in ANALYSIS_OPTIONS.items()}
-
-
 def refusal(error: ValueError, stored=None, shown: str = "") -> InputError:
     """A library refusal as the page shows it: the ``stored`` file's path replaced by the name the user's file had
-    (``shown``), and the input it is about (from the error, or from the ``argument --option:`` the message starts
-    with)."""
+    (``shown``), about the input the error names (the reader's ``path`` is the page's ``file``)."""
     text = str(error) if stored is None else str(error).replace(str(stored), shown)
     argument = getattr(error, "argument", None)
-    if argument == "path":
-        argument = "file"
-    if argument is None and text.startswith("argument --"):
-        option = text[len("argument "):].split(":", 1)[0].split("/")[0]
-        argument = _OPTION_NAMES.get(option)
-    return InputError(text, argument)
+    return InputError(text, "file" if argument == "path" else argument)
 
 
 def command(name: str, inputs: dict) -> str:
@@ -99,29 +91,6 @@ def command(name: str, inputs: dict) -> str:
         option = ANALYSIS_OPTIONS.get(key) or f"--{key}"
         words += [option] if key in _FLAGS else [option, str(inputs[key])]
     return " ".join(shlex.quote(word) for word in words)
-
-
-def _number(value):
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None
-
-
-def _json_row(row: dict) -> dict:
-    """A report as JSON: NaN and infinity as null, NumPy scalars as Python ones."""
-    out = {}
-    for key, value in row.items():
-        if isinstance(value, (bool, np.bool_)):
-            out[key] = bool(value)
-        elif isinstance(value, (int, np.integer)):
-            out[key] = int(value)
-        elif isinstance(value, (float, np.floating)):
-            out[key] = _number(value)
-        else:
-            out[key] = value
-    return out
 
 
 class _Overview:
@@ -198,7 +167,7 @@ def analyze(request, uploads) -> dict:
     if "lanes" in reading:
         from fruitimpact.impact.validation import read_count
 
-        reading["lanes"] = read_count("lanes", reading["lanes"], 1, 64)
+        reading["lanes"] = read_count("lanes", reading["lanes"], 1, MAX_LANES)
     try:
         source = open_recording(path, **reading)
     except ValueError as error:
@@ -214,7 +183,7 @@ def analyze(request, uploads) -> dict:
         run = run_analysis(str(path), on_detected=keep, on_chunk=overview.feed, **reading, **inputs)
     except ValueError as error:
         raise refusal(error, path, upload.name) from None
-    rows = [_json_row(row) for row in run.rows]
+    rows = run.rows  # the server's JSON writer makes NaN null (impact.outputs.dump_json)
     index = run.classes.by if run.classes is not None else "firmness_c_star"
     thresholds = list(run.classes.thresholds) if run.classes is not None else []
     classes = {}

@@ -17,7 +17,6 @@ import concurrent.futures
 import functools
 import json
 import signal
-import socket
 import sys
 import traceback
 from importlib import resources
@@ -43,8 +42,7 @@ HEAVY_WORKERS = 2
 SECURITY_POLICY = ("default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
                    "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
 #: Pages by path: (title, file in ``static``).
-PAGES = {"/": ("Explorer", "explorer.html"), "/line": ("Line audit", "line.html"),
-         "/recording": ("Recording", "recording.html"), "/monitor": ("Live monitor", "monitor.html")}
+PAGES = {"/": "explorer.html", "/line": "line.html", "/recording": "recording.html", "/monitor": "monitor.html"}
 
 
 def _static() -> str:
@@ -255,14 +253,13 @@ class MonitorSocket(tornado.websocket.WebSocketHandler):
         self._stop()
 
 
-def make_app(uploads: UploadStore | None = None) -> tornado.web.Application:
+def make_app(uploads: UploadStore) -> tornado.web.Application:
     """The tornado application: the pages, ``/static/``, the JSON API under ``/api/`` and the uploads (kept in
-    ``uploads``, a new store when None; the caller closes it)."""
-    uploads = uploads if uploads is not None else UploadStore()
+    ``uploads``; its owner closes it)."""
     # line audits and recordings take seconds to minutes: their own two workers, so that they queue among
     # themselves and never hold up the explorer's and the impact view's answers (asyncio's default pool)
     heavy = concurrent.futures.ThreadPoolExecutor(HEAVY_WORKERS, thread_name_prefix="fruitimpact-heavy")
-    routes = [(path, PageHandler, {"page": page}) for path, (_, page) in PAGES.items()]
+    routes = [(path, PageHandler, {"page": page}) for path, page in PAGES.items()]
     routes += [
         (r"/api/upload", UploadHandler, {"uploads": uploads}),
         (r"/api/recording", ApiHandler, {"compute": functools.partial(recording.analyze, uploads=uploads),
@@ -277,14 +274,6 @@ def make_app(uploads: UploadStore | None = None) -> tornado.web.Application:
     ]
     return tornado.web.Application(routes, compress_response=True, max_body_size=MAX_BODY,
                                    websocket_max_message_size=MAX_REQUEST)
-
-
-def is_loopback(host: str) -> bool:
-    """Whether ``host`` is a loopback address (only this machine can connect); ``OSError`` if it is no address."""
-    infos = socket.getaddrinfo(host, None)
-    import ipaddress
-
-    return all(ipaddress.ip_address(info[4][0]).is_loopback for info in infos)
 
 
 async def _serve(host: str, port: int, ready) -> None:
@@ -309,4 +298,4 @@ def serve(host: str = "127.0.0.1", port: int = 8050, ready=None) -> None:
     asyncio.run(_serve(host, port, ready or (lambda h, p: None)))
 
 
-__all__ = ["MAX_REQUEST", "PAGES", "SECURITY_POLICY", "is_loopback", "make_app", "serve"]
+__all__ = ["MAX_REQUEST", "PAGES", "SECURITY_POLICY", "make_app", "serve"]

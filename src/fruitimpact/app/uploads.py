@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import secrets
 import shutil
 import tempfile
@@ -26,7 +27,9 @@ from fruitimpact.signals.read.common import error as read_error
 MAX_UPLOAD = 200 * 1024 * 1024
 #: Uploads kept at once; the oldest is deleted when another arrives.
 MAX_UPLOADS = 6
-#: The file that marks the folder as the server's own.
+#: The folders' prefix in the temporary folder.
+PREFIX = "fruitimpact-app-"
+#: The file that marks the folder as the server's own (and names its process).
 MARKER = ".fruitimpact-app-uploads"
 
 
@@ -74,8 +77,9 @@ class UploadStore:
     them in worker threads."""
 
     def __init__(self, max_uploads: int = MAX_UPLOADS):
-        self.folder = Path(tempfile.mkdtemp(prefix="fruitimpact-app-"))
-        (self.folder / MARKER).write_text("uploads of a fruitimpact serve; removed when it stops\n")
+        remove_orphans()
+        self.folder = Path(tempfile.mkdtemp(prefix=PREFIX))
+        (self.folder / MARKER).write_text(f"uploads of a fruitimpact serve; removed when it stops\npid={os.getpid()}\n")
         self.max_uploads = max_uploads
         self._uploads: dict[str, Upload] = {}
         self._lock = threading.Lock()
@@ -105,6 +109,24 @@ class UploadStore:
         """Delete the uploads and the folder, if the folder is still the server's own (its marker)."""
         if (self.folder / MARKER).is_file():
             shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def remove_orphans() -> int:
+    """Remove the upload folders of servers that were killed before they could (SIGKILL, a crash): only folders
+    marked as a server's own whose process is gone.  Returns how many."""
+    from fruitimpact.impact.outputs import process_alive
+
+    removed = 0
+    for folder in Path(tempfile.gettempdir()).glob(PREFIX + "*"):
+        try:
+            text = (folder / MARKER).read_text()
+        except OSError:  # not a folder, not ours, or not readable: left alone
+            continue
+        match = re.search(r"^pid=(\d+)$", text, re.MULTILINE)
+        if match and not process_alive(int(match[1])):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed += 1
+    return removed
 
 
 class _Writer:
@@ -143,4 +165,4 @@ class _Writer:
         self.partial.unlink(missing_ok=True)
 
 
-__all__ = ["MAX_UPLOAD", "MAX_UPLOADS", "Upload", "UploadStore", "extension_of"]
+__all__ = ["MAX_UPLOAD", "MAX_UPLOADS", "Upload", "UploadStore", "extension_of", "remove_orphans"]

@@ -24,17 +24,24 @@ def add_parsers(sub) -> None:
     serve.set_defaults(func=cmd_serve)
 
 
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is a loopback address (only this machine can connect); ``OSError`` if it is no address."""
+    import ipaddress
+    import socket
+
+    return all(ipaddress.ip_address(info[4][0]).is_loopback for info in socket.getaddrinfo(host, None))
+
+
 def cmd_serve(args) -> int:
     port = read_option_count("--port", args.port, 0, 65535)
     if importlib.util.find_spec("tornado") is None:
         raise UsageError("the web app needs tornado: pip install 'fruitimpact[app]'")
-    from fruitimpact.app import server
-
     host = args.host
     try:
-        loopback = server.is_loopback(host)
+        loopback = is_loopback(host)
     except OSError as error:
         raise UsageError(f"argument --host: {host!r} is not an address: {error.strerror or error}") from None
+    from fruitimpact.app import server  # tornado and the app only once the arguments are good
     if not loopback:
         print(f"{PROG} serve: warning: listening on {host}: anyone on that network can use this app "
               f"(it has no login)", file=sys.stderr)

@@ -101,6 +101,10 @@ def cmd_sweep(args) -> int:
         name = runs.characteristic(args.characteristic).name
     except ValueError as exc:
         raise UsageError(f"argument --characteristic: {exc}") from None
+    if args.plot:  # before the run: a figure of a bruise characteristic needs the criterion
+        from fruitimpact.runs.plan import check_criterion_for
+
+        _library_call(check_criterion_for, (name,), getattr(args, "criterion", None))
     if args.plot and not 1 <= len(axes) <= 2:
         raise UsageError(f"argument --plot: draws one or two swept inputs; {len(axes)} are swept"
                          + (f" ({', '.join(a.name for a in axes)})" if axes else " (give START:STOP:COUNT)"))

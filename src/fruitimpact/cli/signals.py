@@ -10,6 +10,7 @@ import sys
 from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json, read_option_count
 from fruitimpact.impact.validation import conflict_message
 from fruitimpact.impact.outputs import FIGURE_FORMATS
+from fruitimpact.signals.settings import MAX_LANES
 
 
 def _float(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
@@ -117,7 +118,7 @@ class _Progress:
 
 def cmd_analyze(args) -> int:
     rate = _rate(args.rate)
-    lanes = read_option_count("--lanes", args.lanes, 1)
+    lanes = read_option_count("--lanes", args.lanes, 1)  # more than MAX_LANES: the detector refuses them
     check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
@@ -290,9 +291,7 @@ def cmd_synth(args) -> int:
     check_outputs(("-o/--output", args.output, None if args.format else dict(reading.EXTENSIONS)))
     count = read_option_count("--count", args.count, 1, 100_000)
     lanes = read_option_count("--lanes", args.lanes, 1, 64)
-    rebounds = args.rebounds
-    if rebounds not in ("0", "1", "2"):
-        raise UsageError(f"argument --rebounds: must be 0, 1 or 2; got {rebounds!r}")
+    rebounds = read_option_count("--rebounds", args.rebounds, 0, 2)
     clip = _library_call(parse_clip, args.clip)
     for pair in (("velocity", "drop_height"), ("restitution", "alpha")):
         if all(getattr(args, name) is not None for name in pair):
@@ -307,12 +306,12 @@ def cmd_synth(args) -> int:
         drift=_float("--drift", args.drift, "dimensionless", low=-math.inf),
         hum_amplitude=_float("--hum", args.hum, "force", low_inclusive=True),
         hum_frequency=_float("--hum-frequency", args.hum_frequency, "frequency"),
-        adc_bits=int(args.adc_bits) if str(args.adc_bits).isdecimal() else -1,  # the model refuses -1, naming it
+        adc_bits=read_option_count("--adc-bits", args.adc_bits, 0, 32),
         clip_low=clip[0], clip_high=clip[1],
         plate_frequency=_float("--plate-frequency", args.plate_frequency, "frequency", low_inclusive=True),
         plate_damping=_float("--plate-damping", args.plate_damping, "dimensionless") if args.plate_damping else None,
         antialias_cutoff=_float("--antialias", args.antialias, "frequency", low_inclusive=True),
-        seed=int(args.seed) if str(args.seed).isdecimal() else -1)
+        seed=read_option_count("--seed", args.seed, 0))
     sensor = _library_call(SensorModel, **sensor_kwargs)
     height = _float("--drop-height", args.drop_height, "length", high=10.0) if args.drop_height is not None else None
     population = _library_call(
@@ -387,7 +386,7 @@ def cmd_stream(args) -> int:
     rate = _rate(args.rate)
     if rate is None:
         raise UsageError("argument --rate: required (the sample rate of the stream [Hz])")
-    lanes = read_option_count("--lanes", args.lanes, 1, 256)
+    lanes = read_option_count("--lanes", args.lanes, 1, MAX_LANES)
     source = {"text": "text", "f32": "float32"}.get(args.format)
     if source is None:
         raise UsageError(f"argument --format: must be text or f32; got {args.format!r}")

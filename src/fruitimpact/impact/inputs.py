@@ -138,7 +138,10 @@ def _fast_float(column, rows: int):
     """(values, given) without looking at cells, for purely numeric columns; None otherwise."""
     if isinstance(column, list):
         if all(type(c) is float or type(c) is int for c in column):
-            return np.asarray(column, dtype=float), np.ones(rows, dtype=bool)
+            try:
+                return np.asarray(column, dtype=float), np.ones(rows, dtype=bool)
+            except OverflowError:  # an integer beyond a float: cell by cell, refused on its row
+                return None
         return None
     if _is_arrow(column):
         import pyarrow as pa
@@ -187,8 +190,11 @@ def _numeric(name: str, column, rows: int, messages: MessageBook) -> tuple[np.nd
             cell = cells[i]
             try:
                 values[i] = float(cell) if not isinstance(cell, bool) else np.nan
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 values[i] = np.nan
+                if isinstance(cell, int):  # an integer beyond a float: unreadable, not a NaN given
+                    messages.set_row(i, unreadable_message(quantity, cell), name)
+                    continue
             if isinstance(cell, bool) or not np.isfinite(values[i]) and not _is_number(cell):
                 messages.set_row(i, unreadable_message(quantity, cell), name)
         texts = given & is_str
@@ -301,10 +307,14 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     for j, name in enumerate(NUMERIC_INPUTS):
         if name in by_key:
             column = by_key[name]
-            if isinstance(column, list) and all(type(c) is float or type(c) is int for c in column):
-                matrix[j] = column  # plain numbers (one impact from simulate, a list of floats)
-                given_matrix[j] = True
-            else:
+            plain = isinstance(column, list) and all(type(c) is float or type(c) is int for c in column)
+            try:
+                if plain:  # plain numbers (one impact from simulate, a list of floats)
+                    matrix[j] = column
+                    given_matrix[j] = True
+            except OverflowError:  # an integer beyond a float: read cell by cell, refused on its row
+                plain = False
+            if not plain:
                 matrix[j], given_matrix[j] = _numeric(name, column, rows, messages)
         values[name], given[name] = matrix[j], given_matrix[j]
     nan = given_matrix & np.isnan(matrix)  # a NaN is a value: refused, never the default

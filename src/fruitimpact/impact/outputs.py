@@ -184,7 +184,8 @@ def atomic_write(path, write, argument: str = "path") -> Path:
 _STALE = re.compile(r"^\.(?P<name>.+)" + re.escape(_TMP_MARK) + r"(?P<pid>\d+)-[0-9a-f]{8}$")
 
 
-def _alive(pid: int) -> bool:
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` is running (this one is): whose leftovers may not be removed yet."""
     if pid == os.getpid():
         return True
     try:
@@ -207,7 +208,7 @@ def stale_temporaries(path) -> list[Path]:
         return found
     for entry in entries:
         match = _STALE.match(entry.name)
-        if match and match["name"] == path.name and not _alive(int(match["pid"])) and entry.is_file():
+        if match and match["name"] == path.name and not process_alive(int(match["pid"])) and entry.is_file():
             found.append(entry)
     return found
 
@@ -230,13 +231,17 @@ def _json_default(value):
     return str(value)
 
 
-def _finite(obj):
+def json_safe(obj):
+    """``obj`` with NaN and infinity as None, NumPy scalars as Python numbers and tuples as lists: what strict
+    JSON holds (``dump_json``'s input; the web app's answers)."""
+    if type(obj).__module__ == "numpy" and hasattr(obj, "item") and getattr(obj, "ndim", 1) == 0:
+        obj = obj.item()  # an np.int64 is a number, not the text "3"
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
+        return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
+        return [json_safe(v) for v in obj]
     return obj
 
 
@@ -244,10 +249,10 @@ def dump_json(obj, indent: int | None = 2) -> str:
     """Strict JSON of ``obj`` (the CLI's ``--json``, the web app's answers): NaN and infinity written as null,
     anything else not JSON by its text; ``indent=None``: one compact line."""
     separators = None if indent is not None else (",", ":")
-    return json.dumps(_finite(obj), indent=indent, separators=separators, default=_json_default, allow_nan=False,
+    return json.dumps(json_safe(obj), indent=indent, separators=separators, default=_json_default, allow_nan=False,
                       ensure_ascii=indent is not None)
 
 
 __all__ = ["CSV_FORMAT", "FIGURE_FORMATS", "TABLE_FORMATS", "atomic_write", "check_folder", "check_output", "dump_json",
-           "check_output_folder",
+           "check_output_folder", "json_safe", "process_alive",
            "output_error", "output_format", "remove_stale_temporaries", "stale_temporaries", "temporary_path"]

@@ -72,7 +72,10 @@ def read_value(name: str, value) -> float:
     if is_boolean(value):  # True is not 1.0
         raise InputError(unreadable_message(quantity, value), name)
     if isinstance(value, numbers.Real):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:  # an integer beyond a float (10**400)
+            raise InputError(unreadable_message(quantity, value), name) from None
     if isinstance(value, str):
         try:
             return parse_quantity(value, quantity.dimension)
@@ -80,7 +83,7 @@ def read_value(name: str, value) -> float:
             raise InputError(unreadable_message(quantity, value), name) from None
     try:
         return float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(unreadable_message(quantity, value), name) from None
 
 

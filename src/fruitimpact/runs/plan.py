@@ -51,6 +51,21 @@ def characteristic(name: str) -> Quantity:
     return CHARACTERISTICS[name]
 
 
+#: Characteristics that only a bruise criterion gives (NaN for every row without one).
+CRITERION_CHARACTERISTICS = ("bruise_margin", "bruised", "bruise_volume", "bruise_depth", "bruise_width")
+
+
+def check_criterion_for(names, criterion) -> None:
+    """``InputError`` naming ``criterion`` when one of ``names`` needs a bruise criterion and none is given: a
+    summary or figure of it would be empty while the run says ok."""
+    from fruitimpact.impact.validation import InputError
+
+    needing = [name for name in names if name in CRITERION_CHARACTERISTICS]
+    if needing and (criterion is None or str(criterion).strip().lower() in ("", "none")):
+        raise InputError(f"criterion must be given for {', '.join(needing)}: pressure, shear or energy (without one "
+                         f"every row's {needing[0]} is NaN)", "criterion")
+
+
 def characteristics_list(text: str) -> tuple[str, ...]:
     """``"peak_force,contact_duration"`` → validated names."""
     names = tuple(n.strip() for n in text.split(",") if n.strip())

@@ -19,7 +19,8 @@ from pathlib import Path
 from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name, is_boolean,
                                            read_count, spec_text)
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
-                                   Plan, Threshold, characteristic, characteristics_list)
+                                   Plan, Threshold, characteristic, characteristics_list,
+                                   check_criterion_for)
 
 #: Most worker processes of a local Dask cluster.
 MAX_WORKERS = 256
@@ -310,6 +311,7 @@ def population_plan(inputs: Mapping, *, rows=10_000, seed=0, spreads: bool = Tru
                 raise ValueError("give at least one characteristic")
     except ValueError as exc:
         raise InputError(f"characteristics: {exc}", "characteristics") from None
+    check_criterion_for(names, inputs.get("criterion"))
     parsed = []
     if thresholds is None or not isinstance(thresholds, (str, list, tuple)):
         raise InputError(f"threshold: thresholds are texts such as 'peak_force>60N', one or a list; got "

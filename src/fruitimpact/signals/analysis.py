@@ -95,7 +95,8 @@ class Analysis:
     def __post_init__(self):
         if self.fit and (self.velocity is None) == (self.mass is None):
             raise InputError("the fit needs exactly one of the impact velocity (--velocity or --drop-height) and "
-                             "the mass (--mass): one pulse determines three of k_c, c, m, V", "drop_height")
+                             "the mass (--mass): one pulse determines three of k_c, c, m, V",
+                             "mass" if self.mass is not None else "drop_height")  # the one to take out, or give
         if (self.diameter is None) != (self.poisson is None):
             raise ValueError("give both --diameter and --poisson (the modulus follows from k_c with both)")
         if self.classes is not None and self.classes.by in ("modulus", "stiffness") and not self.fit:

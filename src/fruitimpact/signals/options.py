@@ -20,17 +20,26 @@ ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "rebound_window": "-
 ANALYSIS_DEFAULTS = {"k_on": "6", "k_off": "3", "fit": False}
 
 
+_NAMES = {option: name for name, option in ANALYSIS_OPTIONS.items()}
+
+
+def _refusal(option: str, text: str) -> InputError:
+    """``argument OPTION: TEXT``, about the option's input (its Python name: the web app shows the line next to
+    that control; the first of ``--a/--b``)."""
+    return InputError(f"argument {option}: {text}", _NAMES.get(option.split("/")[0]))
+
+
 def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
     if text is None:
         return None
     try:
         value = parse_quantity(text, dimension)
     except ValueError as exc:
-        raise InputError(f"argument {option}: {exc}") from None
+        raise _refusal(option, str(exc)) from None
     ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
     if not ok:
         bracket = "[" if low_inclusive else "("
-        raise InputError(f"argument {option}: must be a number in {bracket}{low:.7g}, {high:.7g}]; got {text!r}")
+        raise _refusal(option, f"must be a number in {bracket}{low:.7g}, {high:.7g}]; got {text!r}")
     return value
 
 
@@ -46,7 +55,7 @@ def _setting_error(exc: ValueError) -> InputError:
         return exc  # it names its input already
     text = str(exc)
     option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
-    return InputError(f"argument {option}: {text}" if option else text)
+    return _refusal(option, text) if option else InputError(text)
 
 
 def parse_clip(text) -> tuple:
@@ -56,9 +65,9 @@ def parse_clip(text) -> tuple:
     try:
         low, high = (float(parse_quantity(v, "force")) for v in str(text).split(","))
     except ValueError:
-        raise InputError(f"argument --clip: expected LOW,HIGH in N; got {text!r}") from None
+        raise _refusal("--clip", f"expected LOW,HIGH in N; got {text!r}") from None
     if not low < high:
-        raise InputError(f"argument --clip: LOW must be below HIGH; got {text!r}")
+        raise _refusal("--clip", f"LOW must be below HIGH; got {text!r}")
     return low, high
 
 
@@ -112,14 +121,14 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         raise _setting_error(exc) from None
     classes = None
     if args.classes and not (args.sort_by or args.thresholds):
-        raise InputError("argument --classes: names the classes of --sort-by INDEX --thresholds A,B,...: give them too")
+        raise _refusal("--classes", "names the classes of --sort-by INDEX --thresholds A,B,...: give them too")
     if args.sort_by or args.thresholds:
         if not (args.sort_by and args.thresholds):
-            raise InputError("argument --thresholds: give --sort-by INDEX and --thresholds A,B,... together")
+            raise _refusal("--thresholds", "give --sort-by INDEX and --thresholds A,B,... together")
         try:
             thresholds = tuple(float(v) for v in args.thresholds.split(","))
         except ValueError:
-            raise InputError(f"argument --thresholds: expected numbers A,B,...; got {args.thresholds!r}") from None
+            raise _refusal("--thresholds", f"expected numbers A,B,...; got {args.thresholds!r}") from None
         names = tuple(args.classes.split(",")) if args.classes else \
             (("soft", "medium", "firm", "very-firm", "hard", "very-hard")[:len(thresholds) + 1]
              if len(thresholds) < 6 else tuple(f"class{k}" for k in range(len(thresholds) + 1)))
@@ -128,7 +137,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         try:
             classes = FirmnessClasses(args.sort_by, thresholds, names)
         except ValueError as exc:
-            raise InputError(f"argument --sort-by/--thresholds: {exc}") from None
+            raise _refusal("--sort-by/--thresholds", str(exc)) from None
     from fruitimpact.signals.analysis import Analysis
 
     try:

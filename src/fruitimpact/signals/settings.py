@@ -12,7 +12,10 @@ from dataclasses import dataclass
 from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_integer, check_number, is_boolean
 
-__all__ = ["DetectorSettings"]
+#: Most lanes (force channels) of one recording or stream: analyze, stream and the web app's pages.
+MAX_LANES = 256
+
+__all__ = ["MAX_LANES", "DetectorSettings"]
 
 
 @dataclass(frozen=True)

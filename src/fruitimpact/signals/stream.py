@@ -36,6 +36,7 @@ import numpy as np
 from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.analysis import Analysis
 from fruitimpact.signals.detect import DetectedImpact, Detector, DetectorSettings
+from fruitimpact.signals.settings import MAX_LANES
 
 __all__ = ["Float32Source", "StreamAnalyzer", "TextSource", "iter_chunks", "serve"]
 
@@ -51,7 +52,7 @@ def _default_problem(message: str) -> None:
 
 
 def _lanes(lanes) -> int:
-    return check_integer("lanes", lanes, 1, 1024)
+    return check_integer("lanes", lanes, 1, MAX_LANES)
 
 
 class _Problems:

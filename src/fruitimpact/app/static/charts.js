@@ -234,5 +234,5 @@ const Charts = (() => {
     });
   }
 
-  return {line, heat, bars, histogram, serialize, png, format};
+  return {line, heat, bars, histogram, serialize, png};
 })();

@@ -8,7 +8,6 @@ const statusLine = document.getElementById("status");
 const CURVES_SHOWN = 5;       // latest force curves per lane
 const FIRMNESS_SHOWN = 120;   // fruit in a lane's rolling firmness chart
 const RATE_WINDOW = 5;        // fruit per second over this much signal [s]
-const CLASS_COLORS = ["#c98b2b", "#6f9f5f", "#2f6f4f", "#2b5d9b", "#7a3e9d", "#444"];
 let socket = null, upload = null, lanes = {}, state = null, limit = 200 * 1024 * 1024, dirty = false;
 // What a test or a curious user can read: every count the page shows, and the stream's own summary.
 window.fruitimpact = {contacts: 0, fruit: 0, summaries: [], ended: false, started: null, frames: 0};
@@ -100,8 +99,7 @@ function started(message) {
   window.fruitimpact.started = message;
   state.classes = message.classes;
   document.getElementById("state").textContent = "running";
-  const note = document.getElementById("source-note");
-  note.textContent = message.source === "tcp"
+  document.getElementById("source-note").textContent = message.source === "tcp"
     ? `Listening on 127.0.0.1:${message.port} for ${message.lanes.length} lane(s) at ${fmt(message.rate / 1000, 4)} kHz: send the samples there (text lines, or raw float32 with format f32), e.g. your acquisition's output through nc 127.0.0.1 ${message.port}.`
     : `Replaying ${message.file} (${message.lanes.length} lane(s) at ${fmt(message.rate / 1000, 4)} kHz) ${message.speed ? `at ${message.speed} × real time` : "as fast as the detector goes"}.`;
   statusLine.textContent = "running";
@@ -175,7 +173,7 @@ function showFigures() {
   document.getElementById("latency").textContent = f.latency_p50 === null ? "–" : `${fmt(f.latency_p50 * 1e3, 3)} / ${fmt(f.latency_p99 * 1e3, 3)} ms`;
 }
 
-function drawLane(name, lane) {
+function drawLane(lane) {
   const n = lane.curves.length;
   const series = lane.curves.map((curve, i) => ({x: curve.time, y: curve.force, color: i === n - 1 ? "#2f6f4f" : "#b9c7bf",
                                                 label: i === n - 1 ? `latest: F_max ${fmt(curve.peak_force, 3)} N` : ""}));
@@ -206,7 +204,7 @@ function render() {
   if (dirty && state) {
     dirty = false;
     showFigures();
-    for (const [name, lane] of Object.entries(lanes)) drawLane(name, lane);
+    for (const lane of Object.values(lanes)) drawLane(lane);
   }
   requestAnimationFrame(render);
 }
