@@ -26,6 +26,8 @@ import math
 import sys
 from functools import lru_cache
 
+import numpy as np
+
 from fruitimpact.damage.bruise import hertz_max_shear
 from fruitimpact.engine.checks import PHYSICAL, classify_row
 from fruitimpact.engine.codes import CONTACT_RADIUS, MAX_PRESSURE
@@ -230,8 +232,10 @@ def impact(fruit, surface, keywords: dict, curve_points: int):
         return None  # a warning the table path words
     characteristics = dict(zip(CHARACTERISTIC_COLUMNS, values))
     x = factor * velocity
-    characteristics["max_deflection_closed_form"] = (2.5 * mass * velocity ** 2 * r_func(x) / law_stiffness) \
-        ** (1.0 / 2.5)
+    # the power through NumPy's array loop, as solvers.power_law_closed_forms takes it: its SIMD pow and the
+    # scalar libm pow differ in the last bit for some arguments (NumPy 2.4 on AVX-512)
+    base = 2.5 * mass * velocity ** 2 * r_func(x) / law_stiffness
+    characteristics["max_deflection_closed_form"] = float(np.power(np.array([base]), 1.0 / 2.5)[0])
     characteristics["restitution_closed_form"] = restitution_of_x(x)
     absorbed = characteristics["absorbed_energy"]
     fruit_energy = absorbed * (1.0 if math.isinf(surface_modulus) else pair_modulus / fruit_modulus)
