@@ -57,7 +57,8 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "refine", "shape_table"]
+__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "rebounds_due",
+           "refine", "shape_table"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
@@ -278,3 +279,60 @@ def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: f
         return NEW_FRUIT
     return Verdict(rebound, best["parent"] if rebound else None, ambiguous,
                    best["speed_ratio"] if rebound else None, best)
+
+
+def rebounds_due(onset: float, end: float, earlier: list[PulseSummary], *, max_flight: float) -> list[PulseSummary]:
+    """The earlier contacts whose rebound, not yet seen, is due to land during [onset, end] [s], latest first.
+
+    Due: it left the plate at its separation with its measured restitution e_p at its known impact speed
+    V_p, so it lands again after 2 r V_p/g with r within the speed-ratio tolerances of e_p (spin takes up to
+    25 %, nothing adds more than 10 %) and the flight within its own ±25 % (``TOLERANCES``).  A contact in
+    that window may hold the rebound and a new fruit landing within a millisecond or two of each other:
+    one pulse to the eye, two to a joint fit (``analysis``)."""
+    tol = TOLERANCES
+    due = []
+    for parent in reversed(earlier):
+        if parent.rebound_taken or parent.velocity is None or not parent.refined or parent.onset >= onset:
+            continue
+        if onset - parent.separation > max_flight:
+            continue
+        flight = 2.0 * parent.restitution * parent.velocity / STANDARD_GRAVITY
+        lo = parent.separation + flight * (1.0 - tol["speed_ratio"]) * (1.0 - tol["flight"])
+        hi = parent.separation + flight * (1.0 + tol["speed_ratio_up"]) * (1.0 + tol["flight"])
+        if lo <= end and onset <= hi:
+            due.append(parent)
+    return due
+
+
+#: The speed ratio a rebound is expected at, as a share of its parent's restitution, and its relative sd: spin
+#: and an off-axis bounce take 0–25 % of the exit speed and nothing adds more than 10 % (``TOLERANCES``), so
+#: r = e_p (1 − 0.08) ± 10 % covers that range within 1.7 sd.
+EXPECTED_RATIO, EXPECTED_RATIO_SD = 0.92, 0.10
+
+
+def expected_rebound(parent: PulseSummary) -> dict:
+    """The pulse that ``parent``'s rebound should be, as priors for a joint fit (``split.split_contact``):
+    the same fruit (m, K, c) at r V_p, so with x_r = r x_p
+
+        ln F_r = ln F_p + 1.2 ln r + ln P(x_r)/P(x_p),   ln T_r = ln T_p − 0.2 ln r + ln τ_T(x_r)/τ_T(x_p),
+
+    at r = ``EXPECTED_RATIO`` e_p; each sd combines the spread of r (propagated through its derivative), the
+    spot it lands on (``TOLERANCES["spot"]``) and the parent's own measurement.  Returns the keys
+    ``log_peak``, ``log_duration``, ``x`` and their ``*_sd``."""
+    tol = TOLERANCES
+    duration = parent.separation - parent.onset
+
+    def scales(r):
+        xr = r * parent.x
+        log_peak = math.log(parent.peak_force) + 1.2 * math.log(r) + math.log(_at("P", xr) / _at("P", parent.x))
+        log_duration = math.log(duration) - 0.2 * math.log(r) + math.log(_at("T", xr) / _at("T", parent.x))
+        return log_peak, log_duration, xr
+
+    r = EXPECTED_RATIO * parent.restitution
+    log_peak, log_duration, xr = scales(r)
+    up, down = scales(r * (1 + EXPECTED_RATIO_SD)), scales(r * (1 - EXPECTED_RATIO_SD))
+    spread = [abs(a - b) / 2.0 for a, b in zip(up, down)]
+    return {"log_peak": log_peak, "log_duration": log_duration, "x": xr,
+            "log_peak_sd": math.sqrt(spread[0] ** 2 + tol["spot"] ** 2 + parent.peak_force_sd ** 2),
+            "log_duration_sd": math.sqrt(spread[1] ** 2 + tol["spot"] ** 2 + parent.time_to_peak_sd ** 2),
+            "x_sd": math.sqrt(spread[2] ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2)}
