@@ -139,7 +139,8 @@ def confusion_text(g: dict, markdown: bool = False) -> str:
     summary = (f"fruit {g['fruit']}; clear (true E ≥ 5 % from a threshold, first contact overlapping nothing) "
                f"{g['clear']}: right {g['clear_right']} = {g['clear_accuracy']:.1%} "
                f"(goal ≥ {lg.GRADING_GOAL:.0%}) {'✓' if ok else '✗'}; ungraded {g['ungraded']}; "
-               f"overlapped first contacts {g['overlapped']}")
+               f"overlapped first contacts {g['overlapped']} (of their {g['overlapped_clear']} clear fruit, "
+               f"{g['overlapped_right']} right)")
     return body + ("\n\n" if markdown else "\n") + summary
 
 

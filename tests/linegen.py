@@ -694,7 +694,7 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
     clear = right = ungraded = 0
     wrong = []
     contacts = truth["contacts"]
-    overlapped = 0
+    overlapped = overlapped_clear = overlapped_right = 0
     for f in truth["fruit"]:
         first = contacts[f["contacts"][0]]
         report = report_of.get(first["index"])
@@ -702,7 +702,10 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
         ungraded += got is None
         confusion[f["class"]][got if got in classes else "none"] += 1
         if first["overlaps"]:
-            overlapped += 1  # its force is summed with another contact's: not gradable (issue item 2)
+            overlapped += 1  # its force is summed with another contact's: not required to be gradable (item 2)
+            if np.all(np.abs(f["modulus"] / thresholds - 1.0) >= margin):
+                overlapped_clear += 1
+                overlapped_right += got == f["class"]
             continue
         if np.all(np.abs(f["modulus"] / thresholds - 1.0) >= margin):
             clear += 1
@@ -713,7 +716,7 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
                                   reported_rebound=None if report is None else report.get("rebound")))
     return dict(fruit=len(truth["fruit"]), confusion=confusion, clear=clear, clear_right=right,
                 clear_accuracy=right / clear if clear else float("nan"), ungraded=ungraded, overlapped=overlapped,
-                wrong=wrong)
+                overlapped_clear=overlapped_clear, overlapped_right=overlapped_right, wrong=wrong)
 
 
 __all__ = ["APPLE", "CLASSES", "EXTENSION", "FruitKind", "G", "GOALS", "GRADED_APPLE", "GRADING_GOAL",

@@ -295,6 +295,70 @@ def test_a_fruit_alone_where_a_rebound_is_due_stays_one_fruit():
     assert second["stiffness"] == pytest.approx(b["K"], rel=0.03)
 
 
+@pytest.mark.parametrize("seed", [3, 4, 5])
+def test_a_fruit_and_two_rebounds_landing_together_are_three_contacts(seed):
+    """Two fruit whose rebounds are both due where a third fruit lands: the new fruit, the first's rebound 1.2 ms
+    later and the second's 3.5 ms later make one contact.  Split in two, then the piece holding two pulses split
+    again (analysis._split_further): three reports, each rebound with its own parent, onsets within 0.3 ms, peaks
+    within 12 % (three overlapping rises share their amplitudes; 3 seeds gave ≤ 11 %)."""
+    a, b = impact(), impact(mass=0.9 * MASS, restitution=0.5)
+    back_a = impact(velocity=a["e"] * V_LINE, c=a["c"])
+    back_b = impact(mass=0.9 * MASS, velocity=b["e"] * V_LINE, c=b["c"])
+    landing = 0.1 + a["T"] + 2 * a["e"] * V_LINE / G
+    onset_b = landing + 0.0035 - b["T"] - 2 * b["e"] * V_LINE / G  # b's rebound lands 3.5 ms after a's
+    c = impact(mass=1.1 * MASS, restitution=0.55)
+    onsets = [landing - 0.0012, landing, landing + 0.0035]
+    x = _signal([0.1, onset_b, *onsets], [a, b, c, back_a, back_b], 12000, seed=seed)
+    first, second, *rest = _reports(x)
+    assert len(rest) == 3 and all("one of three fruit in one contact" in r["message"] for r in rest)
+    for report, imp, onset, parent in zip(rest, (c, back_a, back_b), onsets, (None, first, second)):
+        assert report["start_time"] == pytest.approx(onset, abs=3e-4)
+        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.12)
+        assert report["rebound_of"] == (None if parent is None else parent["sequence"])
+
+
+def _lane_fruit(count=8, seed=11):
+    """Summaries of a lane's measured fruit: masses ±15 %, restitution 0.52–0.62 at the line's speed (the exact
+    engine's characteristics, refined as a shape fit would)."""
+    rng = np.random.default_rng(seed)
+    fruit = []
+    for k in range(count):
+        imp = impact(mass=MASS * rng.uniform(0.85, 1.15), restitution=rng.uniform(0.52, 0.62))
+        fruit.append(summary(imp, 0.1 * k, k, velocity=V_LINE))
+    return fruit
+
+
+def test_the_rebound_of_a_fruit_hidden_in_an_overlap_is_judged_against_the_lanes_fruit():
+    """A fruit hidden in an overlap (no pulse of its own) lands at the line's speed and is one of the lane's:
+    its rebound (the same fruit at e V, after 2 e V/g) is a rebound of the overlap, while a new fruit landing
+    at the same moment (impulse m V (1 + e), restitution the lane's) is a new fruit, and so is a contact that
+    would be a rebound but comes at twice the flight (rebounds.judge_unmeasured)."""
+    from fruitimpact.signals.rebounds import judge_unmeasured
+
+    fruit = _lane_fruit()
+    hidden = impact(restitution=0.57)
+    back = impact(velocity=hidden["e"] * V_LINE, c=hidden["c"])
+    left = 1.0 + hidden["T"]
+    flight = 2 * 0.95 * hidden["e"] * V_LINE / G  # a little spin
+    verdict = judge_unmeasured(summary(back, left + flight, 99), 42, 1.0, fruit, V_LINE)
+    assert verdict.rebound and verdict.parent == 42, verdict.evidence
+    new = judge_unmeasured(summary(impact(mass=0.95 * MASS, restitution=0.58), left + flight, 99), 42, 1.0, fruit,
+                           V_LINE)
+    assert not new.rebound, new.evidence
+    late = judge_unmeasured(summary(back, left + 2 * flight, 99), 42, 1.0, fruit, V_LINE)
+    assert not late.rebound, late.evidence
+
+
+def test_without_the_lanes_fruit_or_speed_a_hidden_fruits_rebound_is_not_guessed():
+    """Fewer than 5 measured fruit, or no line speed: nothing stands for the hidden fruit, so no decision."""
+    from fruitimpact.signals.rebounds import NEW_FRUIT, judge_unmeasured
+
+    hidden = impact()
+    back = summary(impact(velocity=hidden["e"] * V_LINE, c=hidden["c"]), 1.1, 99)
+    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(4), V_LINE) is NEW_FRUIT
+    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(), None) is NEW_FRUIT
+
+
 def test_one_fruit_alone_is_never_an_overlap():
     """The same fruit alone at 1 % noise, 20 seeds: status ok every time (its residual is the noise)."""
     a = impact()

@@ -65,8 +65,9 @@ from fruitimpact.engine.powerlaw import (
     powerlaw_curves_batch,
     powerlaw_single,
 )
+from fruitimpact.signals.filters import solve_small
 
-# The public names; PulseModel, levenberg_marquardt, derived and named_result also serve split.py.
+# The public names; PulseModel, fit_pulse_sum, derived and named_result also serve split.py.
 __all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve", "prepare",
            "shape_table_error"]
 
@@ -163,41 +164,72 @@ def _theta_coefficients(x, coefficients, width, a, da):
 
 @nb.njit(cache=True, error_model="numpy")
 def _pulse(t, t0, peak, duration, a, da, model, jacobian):
-    """F = peak · H((t − t0)/duration) at each t and, if ``jacobian`` has rows, ∂F/∂(t0, ln peak,
-    ln duration, x) there (H from the θ coefficients ``a``, ∂H/∂x from ``da``)."""
+    """F = peak · H((t − t0)/duration) at each t (ascending) and, if ``jacobian`` has rows, ∂F/∂(t0, ln peak,
+    ln duration, x) there (H from the θ coefficients ``a``, ∂H/∂x from ``da``).  The Chebyshev recurrences run
+    term by term over all samples of the pulse at once (independent samples: vector instructions), not sample
+    by sample (a chain of dependent operations)."""
     want = jacobian.shape[0] > 0
     n_terms = a.shape[0]
-    for i in range(t.shape[0]):
+    n = t.shape[0]
+    lo, hi = n, 0
+    for i in range(n):
         sigma = (t[i] - t0) / duration
-        if not (0.0 < sigma < 1.0):
+        if 0.0 < sigma < 1.0:
+            lo = min(lo, i)
+            hi = i + 1
+        else:
             model[i] = 0.0
             if want:
                 for col in range(4):
                     jacobian[i, col] = 0.0
-            continue
-        theta = math.acos(1.0 - 2.0 * sigma)
-        s = 2.0 * theta / math.pi - 1.0
-        h = a[0] + a[1] * s
-        hx = da[0] + da[1] * s
-        hs = a[1]
-        t_prev, t_cur = 1.0, s
-        d_prev, d_cur = 0.0, 1.0
-        for j in range(2, n_terms):
-            t_j = 2.0 * s * t_cur - t_prev
-            d_j = 2.0 * t_cur + 2.0 * s * d_cur - d_prev
-            h += a[j] * t_j
-            hx += da[j] * t_j
-            hs += a[j] * d_j
-            t_prev, t_cur = t_cur, t_j
-            d_prev, d_cur = d_cur, d_j
-        model[i] = peak * h
-        if want:
-            # dH/dσ = dH/ds · (2/π) · dθ/dσ,  dθ/dσ = 1/√(σ(1 − σ))
-            h_sigma = hs * (2.0 / math.pi) / math.sqrt(sigma * (1.0 - sigma))
-            jacobian[i, 0] = -peak * h_sigma / duration
-            jacobian[i, 1] = model[i]
-            jacobian[i, 2] = -peak * h_sigma * sigma
-            jacobian[i, 3] = peak * hx
+    if hi <= lo:
+        return
+    m = hi - lo
+    sig = np.empty(m)
+    s = np.empty(m)
+    for k in range(m):
+        sig[k] = (t[lo + k] - t0) / duration
+        s[k] = 2.0 * math.acos(1.0 - 2.0 * sig[k]) / math.pi - 1.0
+    if not want:  # the value alone: Clenshaw's recurrence, a third of the work
+        b1 = np.zeros(m)
+        b2 = np.zeros(m)
+        for j in range(n_terms - 1, 0, -1):
+            aj = a[j]
+            for k in range(m):
+                value = 2.0 * s[k] * b1[k] - b2[k] + aj
+                b2[k] = b1[k]
+                b1[k] = value
+        for k in range(m):
+            model[lo + k] = peak * (s[k] * b1[k] - b2[k] + a[0])
+        return
+    h = np.empty(m)
+    hx = np.empty(m)
+    hs = np.empty(m)
+    t_prev, t_cur = np.ones(m), s.copy()
+    d_prev, d_cur = np.zeros(m), np.ones(m)
+    for k in range(m):
+        h[k] = a[0] + a[1] * s[k]
+        hx[k] = da[0] + da[1] * s[k]
+        hs[k] = a[1]
+    for j in range(2, n_terms):
+        aj, daj = a[j], da[j]
+        for k in range(m):
+            t_j = 2.0 * s[k] * t_cur[k] - t_prev[k]
+            d_j = 2.0 * t_cur[k] + 2.0 * s[k] * d_cur[k] - d_prev[k]
+            h[k] += aj * t_j
+            hx[k] += daj * t_j
+            hs[k] += aj * d_j
+            t_prev[k], t_cur[k] = t_cur[k], t_j
+            d_prev[k], d_cur[k] = d_cur[k], d_j
+    for k in range(m):
+        i = lo + k
+        model[i] = peak * h[k]
+        # dH/dσ = dH/ds · (2/π) · dθ/dσ,  dθ/dσ = 1/√(σ(1 − σ))
+        h_sigma = hs[k] * (2.0 / math.pi) / math.sqrt(sig[k] * (1.0 - sig[k]))
+        jacobian[i, 0] = -peak * h_sigma / duration
+        jacobian[i, 1] = model[i]
+        jacobian[i, 2] = -peak * h_sigma * sig[k]
+        jacobian[i, 3] = peak * hx[k]
 
 
 class PulseModel:
@@ -339,9 +371,21 @@ def _start(t, y, model: PulseModel, weights) -> tuple[np.ndarray | None, str]:
 # ---------------------------------------------------------------------------------------------------------
 # Levenberg–Marquardt
 
-def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,)):
+@nb.njit(cache=True)
+def _damping_update(cost, cost_trial, predicted, lam, nu):
+    """One Levenberg–Marquardt damping decision (Nielsen's update): (step accepted, λ, ν, stop at a minimum)."""
+    if cost_trial < cost:
+        rho = (cost - cost_trial) / predicted if predicted > 0.0 else 1.0
+        return True, lam * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 2.0, False
+    lam, nu = lam * nu, nu * 2.0
+    # no decrease even for vanishing steps: θ is a (projected) minimum
+    return False, lam, nu, lam > 1e16 or predicted <= 1e-14 * cost
+
+
+def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,),
+                        max_iterations: int = MAX_ITERATIONS):
     """Minimise Σ (w (F(θ) − y))² over θ = (t0, ln F_max, ln T, x, baseline…) with each x (the entries
-    ``bounded``) projected on [0, X_MAX].
+    ``bounded``) projected on [0, X_MAX], in at most ``max_iterations``.
     Marquardt's diagonal scaling, Nielsen's damping update.  Returns (θ, J at θ, residual, iterations,
     converged, message)."""
 
@@ -362,7 +406,7 @@ def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, wei
     message = "the iteration limit was reached"
     converged = False
     iterations = 0
-    for iterations in range(1, MAX_ITERATIONS + 1):
+    for iterations in range(1, max_iterations + 1):
         a = jac.T @ jac
         g = jac.T @ r
         scale = np.sqrt(np.diag(a))
@@ -387,17 +431,9 @@ def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, wei
             r_trial = evaluate(trial)
             cost_trial = float(r_trial @ r_trial)
             predicted = -(2.0 * g @ step + step @ a @ step)  # decrease of the linear model
-            if cost_trial < cost:
-                rho = (cost - cost_trial) / predicted if predicted > 0.0 else 1.0
-                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
-                nu = 2.0
-                accepted = True
-            else:
-                lam *= nu
-                nu *= 2.0
-                if lam > 1e16 or predicted <= 1e-14 * cost:
-                    # no decrease even for vanishing steps: θ is a (projected) minimum
-                    return theta, jac, r, iterations, True, "converged"
+            accepted, lam, nu, stop = _damping_update(cost, cost_trial, float(predicted), lam, nu)
+            if stop:
+                return theta, jac, r, iterations, True, "converged"
         decrease = cost - cost_trial
         theta = trial
         r, jac = evaluate(theta, True)
@@ -414,6 +450,174 @@ def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, wei
             message = "converged"
             break
     return theta, jac, r, iterations, converged, message
+
+
+@nb.njit(cache=True)
+def _dot(u, v) -> float:
+    """u · v (loops: numba's np.dot needs SciPy's BLAS, which fruitimpact does not require)."""
+    total = 0.0
+    for i in range(u.shape[0]):
+        total += u[i] * v[i]
+    return total
+
+
+@nb.njit(cache=True)
+def _quadratic(a, v) -> float:
+    """v · (a v)."""
+    total = 0.0
+    for i in range(v.shape[0]):
+        for j in range(v.shape[0]):
+            total += v[i] * a[i, j] * v[j]
+    return total
+
+
+@nb.njit(cache=True)
+def _normal_equations(jac, r, a, g):
+    """a = JᵀJ and g = Jᵀr, in place."""
+    rows, m = jac.shape
+    a[:, :] = 0.0
+    g[:] = 0.0
+    for k in range(rows):
+        for i in range(m):
+            ji = jac[k, i]
+            if ji == 0.0:
+                continue
+            g[i] += ji * r[k]
+            for j in range(i, m):
+                a[i, j] += ji * jac[k, j]
+    for i in range(m):
+        for j in range(i):
+            a[i, j] = a[j, i]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, want,
+                   a, da, part, part_jac):
+    """Weighted residuals of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) and the prior rows, and
+    their Jacobian when ``want``."""
+    n = t.shape[0]
+    pulses = theta.shape[0] // 4
+    for i in range(n):
+        r[i] = 0.0
+    if want:
+        jac[:, :] = 0.0
+    empty = np.empty((0, 4))
+    for p in range(pulses):
+        _theta_coefficients(theta[4 * p + 3], coefficients, width, a, da)
+        _pulse(t, theta[4 * p], math.exp(theta[4 * p + 1]), math.exp(theta[4 * p + 2]), a, da, part,
+               part_jac if want else empty)
+        for i in range(n):
+            r[i] += part[i]
+            if want:
+                for c in range(4):
+                    jac[i, 4 * p + c] = part_jac[i, c] * weights[i]
+    for i in range(n):
+        r[i] = (r[i] - y[i]) * weights[i]
+    for k in range(prior_index.shape[0]):
+        r[n + k] = (theta[prior_index[k]] - prior_mean[k]) * prior_weight[k]
+        if want:
+            jac[n + k, prior_index[k]] = prior_weight[k]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, max_iterations,
+                  step_tolerance, x_max):
+    """``levenberg_marquardt`` for a sum of pulses with Gaussian priors on some parameters, compiled: the same
+    scaling, damping update, projection of each x on [0, x_max] and stopping rules.  Returns (θ, weighted
+    Jacobian, weighted residuals, iterations, status): status 1 converged, 0 iteration limit, −1 the model
+    does not depend on every parameter, −2 the normal equations are singular."""
+    n, m = t.shape[0], theta.shape[0]
+    rows = n + prior_index.shape[0]
+    a_c, da_c = np.empty(THETA_NODES), np.empty(THETA_NODES)
+    part, part_jac = np.empty(n), np.empty((n, 4))
+    r, jac = np.empty(rows), np.empty((rows, m))
+    r_trial, jac_unused = np.empty(rows), np.empty((rows, m))
+    theta = theta.copy()
+    _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, True,
+                   a_c, da_c, part, part_jac)
+    cost = _dot(r, r)
+    lam, nu = 1e-3, 2.0
+    step = np.empty(m)
+    a, g = np.empty((m, m)), np.empty(m)
+    trial = np.empty(m)
+    a_n = np.empty((m, m))
+    iterations = 0
+    for iterations in range(1, max_iterations + 1):
+        _normal_equations(jac, r, a, g)
+        scale = np.sqrt(np.diag(a))
+        for k in range(m):
+            if not scale[k] > 0.0:
+                return theta, jac, r, iterations, -1
+        for i in range(m):
+            for j in range(m):
+                a_n[i, j] = a[i, j] / (scale[i] * scale[j])
+        g_n = g / scale
+        accepted = False
+        cost_trial = cost
+        while not accepted:
+            damped = a_n.copy()
+            for k in range(m):
+                damped[k, k] += lam
+                step[k] = -g_n[k]
+            if not solve_small(damped, step, m):
+                lam *= nu
+                nu *= 2.0
+                if lam > 1e16:
+                    return theta, jac, r, iterations, -2
+                continue
+            for k in range(m):
+                trial[k] = theta[k] + step[k] / scale[k]
+                if k % 4 == 3:
+                    trial[k] = min(max(trial[k], 0.0), x_max)
+                step[k] = trial[k] - theta[k]
+            _sum_residuals(t, y, weights, trial, coefficients, width, prior_index, prior_mean, prior_weight, r_trial,
+                           jac_unused, False, a_c, da_c, part, part_jac)
+            cost_trial = _dot(r_trial, r_trial)
+            predicted = -(2.0 * _dot(g, step) + _quadratic(a, step))
+            accepted, lam, nu, stop = _damping_update(cost, cost_trial, predicted, lam, nu)
+            if stop:
+                return theta, jac, r, iterations, 1
+        decrease = cost - cost_trial
+        theta[:] = trial
+        _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, True,
+                       a_c, da_c, part, part_jac)
+        cost = _dot(r, r)
+        # the step against the parameters' standard errors, as levenberg_marquardt: diag((A_n)^-1) by columns
+        small = True
+        column = np.empty(m)
+        singular = False
+        for k in range(m):
+            column[:] = 0.0
+            column[k] = 1.0
+            if not solve_small(a_n.copy(), column, m):
+                singular = True
+                break
+            sd = math.sqrt(abs(column[k]) * cost / max(rows - m, 1)) / scale[k]
+            if abs(step[k]) > step_tolerance * sd:
+                small = False
+        if singular:
+            small = step_tolerance * 0.0 >= np.max(np.abs(step))
+        if small or decrease <= 1e-12 * cost or cost == 0.0:
+            return theta, jac, r, iterations, 1
+    return theta, jac, r, iterations, 0
+
+
+def fit_pulse_sum(t, y, weights, theta, prior_index=None, prior_mean=None, prior_weight=None,
+                  max_iterations: int = MAX_ITERATIONS):
+    """Least squares of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) to samples ``y`` [N] at times
+    ``t`` [s] with ``weights`` (1/σ), and Gaussian priors (extra rows (θ[prior_index] − prior_mean) ·
+    prior_weight): the compiled form of ``levenberg_marquardt`` with the pulse model.  Returns (θ, weighted
+    Jacobian, weighted residuals, iterations, converged)."""
+    coefficients, width = _shape_table()
+    empty_i, empty_f = np.empty(0, np.int64), np.empty(0)
+    theta, jac, r, iterations, status = _lm_pulse_sum(
+        np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(y, dtype=float),
+        np.ascontiguousarray(weights, dtype=float), np.asarray(theta, dtype=float),
+        coefficients, width, empty_i if prior_index is None else np.asarray(prior_index, np.int64),
+        empty_f if prior_mean is None else np.asarray(prior_mean, float),
+        empty_f if prior_weight is None else np.asarray(prior_weight, float),
+        int(max_iterations), STEP_TOLERANCE, X_MAX)
+    return theta, jac, r, iterations, status == 1
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -57,8 +57,8 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "rebounds_due",
-           "refine", "shape_table"]
+__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "judge_unmeasured",
+           "rebounds_due", "refine", "shape_table"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
@@ -336,3 +336,82 @@ def expected_rebound(parent: PulseSummary) -> dict:
             "log_peak_sd": math.sqrt(spread[0] ** 2 + tol["spot"] ** 2 + parent.peak_force_sd ** 2),
             "log_duration_sd": math.sqrt(spread[1] ** 2 + tol["spot"] ** 2 + parent.time_to_peak_sd ** 2),
             "x_sd": math.sqrt(spread[2] ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2)}
+
+
+#: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 3 degrees of freedom
+#: (``judge_unmeasured`` adds its three tests).
+FLIGHT_TOLERANCE_SD, CHI2_3_99 = 2.0, 11.345
+#: Fewest measured fruit of a lane before a contact can be judged the rebound of an unmeasured one (their
+#: medians and spreads stand for the hidden fruit).
+LANE_FRUIT_MIN = 5
+
+
+def _robust_sd(values) -> float:
+    values = np.asarray(values, dtype=float)
+    return float(1.4826 * np.median(np.abs(values - np.median(values))))
+
+
+def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, fruit: list[PulseSummary],
+                     velocity: float | None) -> Verdict:
+    """Is ``candidate`` the rebound of a fruit hidden in an earlier contact that could not be measured (contact
+    ``hidden``, landing at ``hidden_onset`` [s]: it held that fruit and another pulse landing together)?
+
+    The hidden fruit has no pulse of its own, but it is one of the lane's fruit, landing at the line's speed
+    V: its x, e, impulse and duration are those of the lane's measured fruit (``fruit``, at least
+    ``LANE_FRUIT_MIN``), each within the lane's own spread (robust sd).  Its rebound is then the same fruit at
+    r V, r = ``EXPECTED_RATIO`` e_lane, so (as for a measured parent, ``_hypothesis``)
+
+    * it lands 2 r V/g after the hidden fruit left (its onset + the lane's duration), within the flight
+      tolerance and the spread of r;
+    * its restitution is e(r x_lane) (a rebound is slower, so higher), within the lane's spread of x and of r
+      and the candidate's own sd;
+    * its impulse is I_lane r (1 + e_r)/(1 + e_lane), within the lane's spread of impulse (the fruit's mass)
+      and of r.
+
+    Each deviation is reported in units of its tolerance (``TOLERANCES["z"]`` sd for the spreads, the flight's
+    taken as ``FLIGHT_TOLERANCE_SD`` sd).  Each test alone is loose (the lot's spreads), so the evidence is
+    added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with three degrees of freedom
+    (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  Without the line's speed or enough
+    measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
+    if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
+        return NEW_FRUIT
+    tol = TOLERANCES
+    z = tol["z"]
+    e_lane = float(np.median([f.restitution for f in fruit]))
+    log_x = np.log([max(f.x, 1e-6) for f in fruit])
+    x_lane, x_sd = float(np.exp(np.median(log_x))), max(_robust_sd(log_x), tol["shape"])
+    log_impulse = np.log([f.impulse for f in fruit])
+    impulse_lane, impulse_sd = float(np.exp(np.median(log_impulse))), max(_robust_sd(log_impulse), 0.05)
+    duration = float(np.median([f.separation - f.onset for f in fruit]))
+    r = EXPECTED_RATIO * e_lane
+    r_sd = math.hypot(EXPECTED_RATIO_SD, _robust_sd([f.restitution for f in fruit]) / e_lane)
+    xr = r * x_lane
+    e_pred = _at("e", xr)
+    de_dlnx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (2.0 * math.log(1.05))
+    e_sd = math.hypot(abs(de_dlnx) * math.hypot(x_sd, r_sd), candidate.restitution_sd)
+    impulse_pred = impulse_lane * r * (1.0 + e_pred) / (1.0 + e_lane)
+    flight_pred = 2.0 * r * velocity / STANDARD_GRAVITY
+    flight = candidate.onset - (hidden_onset + duration)
+    deviations = {
+        "restitution": abs(candidate.restitution - e_pred) / (z * e_sd),
+        "impulse": abs(math.log(candidate.impulse / impulse_pred))
+        / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
+        "flight": abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) if flight > 0 else math.inf,
+    }
+    # the three tests are independent and each is loose (the lot's spreads), so their evidence is added: the
+    # distance in sd (the flight tolerance taken as 2 sd) against the 99 % point of χ² with 3 degrees of freedom
+    sds = {"restitution": z, "impulse": z, "flight": FLIGHT_TOLERANCE_SD}
+    distance2 = sum((deviations[k] * sds[k]) ** 2 for k in deviations)
+    score = math.sqrt(distance2 / CHI2_3_99) if math.isfinite(distance2) else math.inf
+    evidence = {"unmeasured_parent": hidden, "flight_observed": flight, "flight_predicted": flight_pred,
+                "restitution": candidate.restitution, "restitution_predicted": e_pred, "lane_restitution": e_lane,
+                "impulse": candidate.impulse, "impulse_predicted": impulse_pred, "lane_fruit": len(fruit),
+                "deviations": {k: round(v, 3) if math.isfinite(v) else None for k, v in deviations.items()},
+                "score": round(score, 3) if math.isfinite(score) else None, "threshold": 1.0,
+                "reason": f"contact #{hidden} held a fruit and another pulse landing together and could not be "
+                          f"measured; its fruit's rebound, judged from the lane's {len(fruit)} measured fruit"}
+    rebound = score <= 1.0
+    ambiguous = AMBIGUOUS[0] < score <= AMBIGUOUS[1]
+    if not rebound and not ambiguous:
+        return NEW_FRUIT
+    return Verdict(rebound, hidden if rebound else None, ambiguous, r if rebound else None, evidence)

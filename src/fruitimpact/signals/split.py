@@ -1,31 +1,33 @@
 """Two fruit in one contact, told apart (issue 13, item 2).
 
-When a second fruit (or a rebound) lands on the plate while another is still in contact, the force falls
-from the first maximum and rises again (``indices.second_pulse``).  Both contacts are the simulator's
-Hunt–Crossley pulse and forces on one plate add, so the contact is fitted as the sum of two pulses,
+When a second fruit (or a rebound) lands on the plate while another is still in contact, forces on one plate
+add and both contacts are the simulator's Hunt–Crossley pulse, so the contact is fitted as the sum of two,
 
     F(t) = F_A · H((t − t0_A)/T_A; x_A) + F_B · H((t − t0_B)/T_B; x_B),
 
-by the same Levenberg–Marquardt and tabulated shape H as one pulse (``signals.fit``), eight parameters.
-Two pulses a few milliseconds apart show no dip: the second lands on the first one's rise or peak and only
-its shoulder shows.  So the fit is started from several places (``_starts``): the two maxima and the dip
-between them when there is one, then the best few of a grid of pulse pairs (the second onset anywhere in the
-contact, each pulse 55–85 % of the contact's span, x = 1), each pair's two peaks from linear least squares;
-every start's fit is kept when it is accepted (below), and of those whose χ² are alike the one whose
-restitutions agree with the lane's wins: the first pulse's tail lies under the second, so its restitution
-trades against the second's amplitude (two fits of one overlap, e 0.34 with 94.6 N and e 0.71 with 99.9 N,
-leave the same residual), while a fruit has the lane's restitution and a rebound a higher one.  When an
-earlier fruit's rebound is due in the contact, the physics says more: the rebound is that fruit at its exit
-speed, so its peak, duration and x are known within the spread of the speed ratio and the spot it lands on
-(``rebounds.expected_rebound``).  They enter each fit as Gaussian priors on the pulse nearer them (extra rows
-of the least squares; one fit per start and per contact whose rebound is due), and the separation with the
-least χ² of data and prior together wins.
-The separation is accepted only when the sum
-leaves nothing but the noise (``MISFIT_LIMIT`` of the larger peak beyond it, as for one pulse), both
-pulses lie inside the window in order, and each is well above the noise; then each pulse is reported as
-its own contact, its indices measured on the samples less the other pulse's model, its fit the
-corresponding block of the joint fit (its standard errors from the joint covariance, so the other pulse's
-uncertainty is in them).  Otherwise the contact stays one report with status ``overlap``.
+with the tabulated shape H of one pulse (``signals.fit``), eight parameters, by the same Levenberg–Marquardt
+compiled for a sum of pulses (``fit.fit_pulse_sum``).
+
+Starts.  Two pulses a few milliseconds apart show no dip: the second lands on the first one's rise or peak and
+only a shoulder shows.  So the fit is started from several places (``_starts``): the two maxima and the dip
+between them when the force falls and rises again, then the best of a grid of pulse pairs (the first starting
+with the contact, the second anywhere in it, each 55–85 % of the contact's span, x = 1), each pair's two peaks
+from linear least squares, and ``fits`` of them are fitted (the best of each hypothesis first).
+
+Choice.  The first pulse's tail lies under the second, so several fits can leave the same residual (two fits
+of one overlap: e 0.34 with 94.6 N, or e 0.71 with 99.9 N).  Physics chooses.  When an earlier fruit's rebound
+is due in the contact, that rebound is the same fruit at its exit speed: its peak, duration and x are known
+within the spread of the speed ratio and the spot it lands on (``rebounds.expected_rebound``).  They enter as
+Gaussian priors on one pulse (extra rows of the least squares; the grid also holds pairs with that pulse
+itself), and the least χ² of data and prior together wins.  Without one, of the fits whose χ² are alike, the
+one whose restitutions do not fall below the lane's fruit (a rebound lands slower, so its e is higher).
+
+Acceptance.  A separation is kept only when the sum leaves nothing but the noise (``MISFIT_LIMIT`` of the
+larger peak beyond it, as for one pulse), both pulses lie in the window in order (the last may end a little
+after a window cut before the next contact) and each is well above the noise; then each pulse is reported as
+its own contact, its indices measured on the samples less the other pulse's model, its fit the corresponding
+block of the joint fit (its standard errors from the joint covariance, so the other pulse's uncertainty is in
+them).  Otherwise the contact stays one report with status ``overlap`` (``analysis``).
 """
 
 from __future__ import annotations
@@ -34,7 +36,8 @@ import math
 
 import numpy as np
 
-from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, levenberg_marquardt, named_result
+from fruitimpact.engine.powerlaw import restitution_of_x
+from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, fit_pulse_sum, named_result
 from fruitimpact.signals.indices import SECOND_PULSE_SMOOTHING, departure_from_one_peak
 
 __all__ = ["MISFIT_LIMIT", "split_contact"]
@@ -48,10 +51,21 @@ MISFIT_LIMIT = 0.018
 #: Ratio T/t_c of the starting guesses (a Hunt–Crossley pulse with e ≈ 0.6; the fit moves it).
 _DURATION_OVER_RISE = 3.2
 #: The grid of starts: second onsets over the contact, durations as shares of the contact's span (one pulse
-#: alone spans 100 %; two that overlap each span less), and how many of the best pairs are fitted.
+#: alone spans 100 %; two that overlap each span less).
 GRID_ONSETS = 12
 GRID_DURATIONS = (0.55, 0.7, 0.85)
-GRID_STARTS = 4
+#: Starts fitted: a contact held for two pulses (a dip or a misfit), and one that one pulse fits but in which a
+#: rebound is due (``FITS_DUE``: most contacts of a busy line; each fit costs 2–5 ms).
+FITS = 4
+FITS_DUE = 4
+#: A fit whose prior χ² (three parameters) is within this (the 95 % point of χ² with 3 degrees of freedom) agrees
+#: with the expected rebound.
+PLAUSIBLE_PRIOR_CHI2 = 7.81
+#: Least peak of either pulse of a start, as a share of the contact's peak.
+MIN_SHARE = 0.1
+#: Iterations of one joint fit: from these starts an accepted fit converges in ≤ 20 (90 %) and 52 at most (the
+#: line scenarios); one still moving after 40 is a start in the wrong valley, and another start is tried.
+SPLIT_ITERATIONS = 40
 #: How far a pulse may end after the window [share of its duration]: the window is cut before the next
 #: contact's rise, and a Hunt–Crossley pulse's last 15 % carry ~2 % of its impulse (its force ~(T − t)^1.5).
 END_ALLOWANCE = 0.15
@@ -68,7 +82,7 @@ RESTITUTION_SPREAD = 0.12
 
 
 class _TwoPulses:
-    """F(t; θ_A) + F(t; θ_B) and its Jacobian, for ``levenberg_marquardt``."""
+    """F(t; θ_A) + F(t; θ_B) and its Jacobian (the fitted model, for residuals and the separated forces)."""
 
     def __init__(self, t: np.ndarray):
         self.first, self.second = PulseModel(t), PulseModel(t)
@@ -104,46 +118,54 @@ def _onset(y: np.ndarray, end: int, level: float) -> int:
 
 
 def split_contact(time, force, noise: float, *, velocity=None, mass=None, diameter=None, poisson=None,
-                  restitution=None, expected=()):
+                  restitution=None, expected=(), fits: int = FITS, dip: bool = True):
     """Fit two pulses to one contact (module docstring).
 
     ``time`` [s] and ``force`` [N] are the contact's window (baseline removed), ``noise`` the noise sd [N];
     ``velocity`` or ``mass`` and ``diameter``/``poisson`` as for ``fit.fit_impact`` (applied to both).
     ``restitution``: the lane's typical fruit restitution, when known, to choose between separations that fit
     alike; ``expected``: the pulses one of the two may be (``rebounds.expected_rebound`` of each earlier contact
-    whose rebound is due), each as Gaussian priors on its peak, duration and x (module docstring).
+    whose rebound is due), each as Gaussian priors on its peak, duration and x (module docstring); ``fits``: how
+    many of the best starts are fitted; ``dip``: the force falls and rises again (the landmarks then give the
+    first start; without a dip, landmarks found in the noise would only waste a fit).
     Returns ((result_A, separated force A), (result_B, separated force B)) in time order, each result a dict
     with the keys of ``fit.RESULT_KEYS``, or None when the contact is not separated."""
     t = np.asarray(time, dtype=float)
     y = np.asarray(force, dtype=float)
     if t.size < 24 or not noise > 0:
         return None
-    marks = _landmarks(y)
     t_ref = float(t[0])
     ts = t - t_ref
     model = _TwoPulses(ts)
     weights = np.full(ts.shape, 1.0 / noise)
     args = (velocity if mass is None else None, mass, diameter, poisson)
     found = []
-    for theta in _starts(ts, y, noise, marks):
-        for prior in [_Prior.on_nearer(e, theta) for e in expected] or [None]:
-            fit = _separated(model, ts, y, noise, weights, theta, args, t_ref, prior)
-            if fit is not None:
-                found.append(fit)
-        if not expected and found and found[-1][1] <= GOOD_MISFIT and _implausibility(found[-1][2], restitution) == 0:
-            break
+    for theta, prior in _starts(ts, y, noise, _landmarks(y) if dip else None, expected, fits):
+        fit = _separated(model, ts, y, noise, weights, theta, args, t_ref, prior)
+        if fit is None:
+            continue
+        found.append(fit)
+        if fit[1] <= GOOD_MISFIT and (prior.chi2(fit[2]) <= PLAUSIBLE_PRIOR_CHI2 if prior is not None
+                                      else _implausibility(fit[2], restitution) == 0.0):
+            break  # it leaves only the noise and agrees with what was expected: no other start can do better
     if not found:
         return None
     if expected:  # the posterior: the data's χ² and the prior's
-        return min(found, key=lambda fit: fit[0])[2]
-    least = min(chi2 for chi2, _, _ in found)
-    alike = [fit for fit in found if fit[0] <= least + ALIKE_CHI2]
-    return min(alike, key=lambda fit: (_implausibility(fit[2], restitution), fit[0]))[2]
+        best = min(found, key=lambda fit: fit[0])
+    else:
+        least = min(fit[0] for fit in found)
+        alike = [fit for fit in found if fit[0] <= least + ALIKE_CHI2]
+        best = min(alike, key=lambda fit: (_implausibility(fit[2], restitution), fit[0]))
+    _, _, theta, covariance, rms, iterations = best
+    try:
+        return _parts(theta, covariance, args, t_ref, ts, rms, noise, iterations, model, y)
+    except (OverflowError, ValueError, np.linalg.LinAlgError):  # a part beyond double precision: not separated
+        return None
 
 
 class _Prior:
-    """Gaussian priors on one pulse's (ln F_max, ln T, x) as extra rows of the least squares: the model
-    returns (F(θ), θ[idx]) and the data (y, μ) with weights (1/σ_noise, 1/sd)."""
+    """Gaussian priors on one pulse's (ln F_max, ln T, x): extra rows (θ[index] − mean) · weight of the least
+    squares (``fit.fit_pulse_sum``)."""
 
     KEYS = ("log_peak", "log_duration", "x")
 
@@ -152,49 +174,28 @@ class _Prior:
         self.mean = np.array([expected[k] for k in self.KEYS], dtype=float)
         self.weight = 1.0 / np.array([expected[f"{k}_sd"] for k in self.KEYS], dtype=float)
 
-    @classmethod
-    def on_nearer(cls, expected: dict, theta) -> _Prior:
-        """The prior on the pulse of the start ``theta`` whose peak is nearer the expected one."""
-        return cls(expected, int(abs(theta[5] - expected["log_peak"]) < abs(theta[1] - expected["log_peak"])))
-
     def chi2(self, theta) -> float:
         return float(np.sum(((theta[self.index] - self.mean) * self.weight) ** 2))
 
-    def wrap(self, model):
-        index = self.index
-
-        def fitted(theta, jacobian: bool = False):
-            out = model(theta, jacobian)
-            f, j = out if jacobian else (out, None)
-            f = np.concatenate([f, theta[index]])
-            if not jacobian:
-                return f
-            rows = np.zeros((index.size, theta.size))
-            rows[np.arange(index.size), index] = 1.0
-            return f, np.vstack([j, rows])
-
-        return fitted
 
 
-def _implausibility(parts, restitution) -> float:
+def _implausibility(theta, restitution) -> float:
     """How far the parts' restitutions fall below the lane's fruit (0 without a lane value): a fruit has the
     restitution of the lane's fruit and a rebound, landing slower, a higher one (x = c V is smaller), so a part
     far below it is the other pulse's tail traded for its amplitude."""
     if restitution is None:
         return 0.0
-    return sum(max(0.0, restitution - RESTITUTION_SPREAD - part["restitution"]) for part, _ in parts)
+    return sum(max(0.0, restitution - RESTITUTION_SPREAD - restitution_of_x(float(x))) for x in theta[3::4])
 
 
 def _separated(model, ts, y, noise, weights, theta, args, t_ref, prior=None):
-    """(χ², misfit, the two parts) of the joint fit started at ``theta`` when it is accepted (module docstring),
-    else None."""
-    fitted, data, w = model, y, weights
-    if prior is not None:
-        fitted, data, w = prior.wrap(model), np.concatenate([y, prior.mean]), np.concatenate([weights, prior.weight])
-    try:  # a trial step far out (a duration of e^700) is a failed separation, not an error
-        with np.errstate(all="ignore"):
-            theta, jac, _, iterations, converged, _ = levenberg_marquardt(fitted, data, theta, w, bounded=(3, 7))
-    except (OverflowError, ValueError, np.linalg.LinAlgError):
+    """(χ², misfit, θ, covariance, rms, iterations) of the joint fit started at ``theta`` when it is accepted
+    (module docstring), else None."""
+    with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
+        theta, jac, _, iterations, converged = fit_pulse_sum(
+            ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
+            max_iterations=SPLIT_ITERATIONS)
+    if not np.all(np.isfinite(theta)):
         return None
     try:  # a degenerate pulse (a peak or duration beyond double precision) is a failed separation
         with np.errstate(all="ignore"):
@@ -212,16 +213,23 @@ def _separated(model, ts, y, noise, weights, theta, args, t_ref, prior=None):
                 return None
             covariance = np.linalg.inv(jac.T @ jac)
             chi2 = float(np.sum((residual / noise) ** 2)) + (prior.chi2(theta) if prior is not None else 0.0)
-            return chi2, misfit, _parts(theta, covariance, args, t_ref, ts, rms, noise, iterations, model, y)
+            return chi2, misfit, theta, covariance, rms, iterations
     except (OverflowError, ValueError, np.linalg.LinAlgError):
         return None
 
 
-def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks):
-    """Starting θ of the joint fit, most likely first: from the landmarks (two maxima and a dip) when there are
-    any, then the ``GRID_STARTS`` best pulse pairs of a grid (module docstring)."""
+def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), limit: int = FITS) -> list:
+    """The ``limit`` most likely starts of the joint fit, as (θ, prior or None): from the landmarks (two maxima
+    and a dip) when there are any, then pulse pairs of a grid ranked by their χ² (module docstring): the generic
+    pairs (the second onset anywhere in the contact, each pulse ``GRID_DURATIONS`` of its span, x = 1) and, for
+    each expected rebound, that pulse (its own duration and x) at every onset of the grid beside a fruit pulse
+    starting with the contact, or starting with the contact beside a fruit pulse anywhere; each pair's two peaks
+    by linear least squares, its χ² counted with the prior's.  A start with a prior has it on the pulse it
+    expects (for a generic pair, the expected pulse nearest either of its pulses).  Onsets lie on samples, so
+    each pulse shape is computed once and shifted, and every pair is solved at once from their inner products."""
     step = ts[1] - ts[0]
     level = 3.0 * noise
+    starts = []
     if marks is not None and marks[0] < marks[1] < marks[2]:
         first, dip, second = marks
         start_a = _onset(y, first, level)
@@ -230,46 +238,107 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks):
         rise_b = max(ts[second] - ts[start_b], 3 * step)
         peak_a = max(float(y[first]), level)
         peak_b = max(float(y[second] - 0.5 * y[dip]), level)
-        yield np.array([ts[start_a], math.log(peak_a), math.log(_DURATION_OVER_RISE * rise_a), 1.0,
-                        ts[start_b], math.log(peak_b), math.log(_DURATION_OVER_RISE * rise_b), 1.0])
+        theta = np.array([ts[start_a], math.log(peak_a), math.log(_DURATION_OVER_RISE * rise_a), 1.0,
+                          ts[start_b], math.log(peak_b), math.log(_DURATION_OVER_RISE * rise_b), 1.0])
+        starts.append((theta, _nearest_prior(theta, expected)))
     # the contact: from the last sample at the noise level before its maximum to the first after it (a lone
     # noise sample above 3 sd elsewhere in the window must not stretch it)
+    n = ts.size
     top = int(np.argmax(y))
     after = np.flatnonzero(y[top:] <= level)
     if not after.size:
-        return
-    onset, end = ts[_onset(y, top, level)], ts[top + int(after[0])]
-    span = end - onset
+        return starts[:limit]
+    first = _onset(y, top, level)
+    span = float(ts[top + int(after[0])] - ts[first])
     if span < 8 * step:
-        return
-    shape = PulseModel(ts)
-    unit = {}  # (onset, duration) → the unit pulse at x = 1
-
-    def pulse(t0, duration):
-        key = (t0, duration)
-        if key not in unit:
-            unit[key] = shape.pulse((t0, 0.0, math.log(duration), 1.0)).copy()
-        return unit[key]
-
-    candidates = []
+        return starts[:limit]
     durations = [f * span for f in GRID_DURATIONS]
-    for onset_b in onset + np.linspace(3 * step, span - 0.5 * min(durations), GRID_ONSETS):
+    last = first + max(int((span - 0.5 * min(durations)) / step), 4)
+    grid = np.unique(np.linspace(first + 3, last, GRID_ONSETS).round().astype(int))
+    grid = [int(k) for k in grid[grid < n]]
+    shapes, rows, index = {}, [], {}
+    model = PulseModel(ts - ts[0])
+
+    def unit(at: int, duration: float, x: float = 1.0) -> int:
+        """Row of the unit pulse (peak 1) of this duration and x starting at sample ``at``."""
+        key = (at, duration, x)
+        if key not in index:
+            if (duration, x) not in shapes:
+                shapes[duration, x] = model.pulse((0.0, 0.0, math.log(duration), x)).copy()
+            row = np.zeros(n)
+            row[at:] = shapes[duration, x][:n - at]
+            index[key] = len(rows)
+            rows.append(row)
+        return index[key]
+
+    # (row A, row B, duration A, duration B, x A, x B, expected k or −1, the pulse it is, B's onset sample);
+    # A starts with the contact
+    pairs = []
+    for at in grid:
         for duration_a in durations:
             for duration_b in durations:
-                a, b = pulse(onset, duration_a), pulse(float(onset_b), duration_b)
-                gram = np.array([[a @ a, a @ b], [a @ b, b @ b]])
-                try:
-                    peaks = np.linalg.solve(gram, np.array([a @ y, b @ y]))
-                except np.linalg.LinAlgError:
-                    continue
-                if not (peaks > level).all():
-                    continue
-                rest = y - peaks[0] * a - peaks[1] * b
-                candidates.append((float(rest @ rest), float(onset_b), duration_a, duration_b, *peaks))
-    candidates.sort()
-    for _, onset_b, duration_a, duration_b, peak_a, peak_b in candidates[:GRID_STARTS]:
-        yield np.array([onset, math.log(peak_a), math.log(duration_a), 1.0,
-                        onset_b, math.log(peak_b), math.log(duration_b), 1.0])
+                pairs.append((unit(first, duration_a), unit(at, duration_b), duration_a, duration_b, 1.0, 1.0, -1, 0,
+                              at))
+    for k, guess in enumerate(expected):
+        duration_r, x_r = math.exp(guess["log_duration"]), guess["x"]
+        for at in grid:
+            for duration in durations:
+                pairs.append((unit(first, duration), unit(at, duration_r, x_r), duration, duration_r, 1.0, x_r, k, 1,
+                              at))
+                pairs.append((unit(first, duration_r, x_r), unit(at, duration), duration_r, duration, x_r, 1.0, k, 0,
+                              at))
+    table = np.array(pairs)
+    a, b = table[:, 0].astype(int), table[:, 1].astype(int)
+    # row by row (einsum's own loops: a BLAS product this small would wake BLAS's threads, which then spin
+    # beside the stream on a small machine)
+    matrix = np.array(rows)
+    norms, projection = np.einsum("ij,ij->i", matrix, matrix), np.einsum("ij,j->i", matrix, y)
+    aa, bb, ay, by = norms[a], norms[b], projection[a], projection[b]
+    ab = np.einsum("ij,ij->i", matrix[a], matrix[b])
+    with np.errstate(all="ignore"):
+        det = aa * bb - ab * ab
+        peak_a, peak_b = (ay * bb - by * ab) / det, (by * aa - ay * ab) / det
+        chi2 = (y @ y - 2.0 * (peak_a * ay + peak_b * by) + peak_a ** 2 * aa + 2.0 * peak_a * peak_b * ab
+                + peak_b ** 2 * bb) / noise ** 2
+        # a second pulse below a tenth of the contact's peak is the noise or the plate's ringing, not a fruit (a
+        # rebound lands with ≥ 20 % of a fruit's peak): such pairs would only waste a fit
+        floor = max(level, MIN_SHARE * float(y[top]))
+        good = (det > 1e-12 * aa * bb) & (peak_a > floor) & (peak_b > floor)
+        log_a, log_b = np.log(np.where(good, peak_a, 1.0)), np.log(np.where(good, peak_b, 1.0))
+    theta = np.column_stack([np.full(len(pairs), ts[first]), log_a, np.log(table[:, 2]), table[:, 4],
+                             ts[table[:, 8].astype(int)], log_b, np.log(table[:, 3]), table[:, 5]])
+    prior_chi2 = np.zeros(len(pairs))
+    on = np.full((len(pairs), 2), -1)  # (expected k, pulse) of each pair's prior
+    if expected:
+        best = np.full(len(pairs), np.inf)
+        for k, guess in enumerate(expected):
+            for pulse in (0, 1):
+                value = sum(((theta[:, 4 * pulse + 1 + i] - guess[key]) / guess[f"{key}_sd"]) ** 2
+                            for i, key in enumerate(_Prior.KEYS))
+                own = table[:, 6] == k
+                value = np.where((table[:, 6] < 0) | (own & (table[:, 7] == pulse)), value, np.inf)
+                take = value < best
+                best[take], on[take] = value[take], (k, pulse)
+        prior_chi2 = best
+    score = np.where(good, chi2 + prior_chi2, np.inf)
+    ranked = [i for i in np.argsort(score, kind="stable") if np.isfinite(score[i])]
+    # the best start of each hypothesis (which expected rebound is which pulse) first, then the next best: the
+    # grid's coarse χ² alone would spend every fit on one hypothesis
+    firsts = {}
+    for i in ranked:
+        firsts.setdefault((int(on[i, 0]), int(on[i, 1])), i)
+    chosen = list(firsts.values())
+    order = chosen + [i for i in ranked if i not in set(chosen)]
+    for i in order[:max(limit - len(starts), 0)]:
+        prior = _Prior(expected[on[i, 0]], int(on[i, 1])) if on[i, 0] >= 0 else None
+        starts.append((theta[i].copy(), prior))
+    return starts[:limit]
+
+
+def _nearest_prior(theta, expected) -> _Prior | None:
+    """The prior of the expected pulse nearest either pulse of ``theta`` (least prior χ²), or None."""
+    priors = [_Prior(guess, pulse) for guess in expected for pulse in (0, 1)]
+    return min(priors, key=lambda prior: prior.chi2(theta), default=None)
 
 
 def _parts(theta, covariance, args, t_ref, ts, rms, noise, iterations, model, y):
