@@ -234,21 +234,35 @@ def test_an_overlap_that_cannot_be_told_apart_has_no_firmness():
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_two_fruit_landing_together_are_told_apart_though_no_dip_shows(seed):
-    """Two fruit touching 1.5 ms apart make one unimodal pulse (no dip: the second lands on the first's rise),
-    but no single fruit's force law fits it (the fit misses it by several % of the peak beyond the noise, above
-    the 1.8 % of analysis.MISFIT_LIMIT), and the joint fit started from the grid of pulse pairs
-    (signals/split.py) tells them apart: two reports, each onset within 0.1 ms of its fruit's.  Peak and
-    stiffness within 8 %: the second pulse's rise lies under the first's, so their amplitudes and the first's
-    tail trade against each other (the joint covariance gives 2–4 % sd at 1 % noise; 6 seeds gave ≤ 7 %)."""
+@pytest.mark.parametrize("gap", [2.0e-3, 3.0e-3])
+def test_two_fruit_landing_together_are_told_apart_though_no_dip_shows(gap, seed):
+    """Two fruit touching 2–3 ms apart (about one time to peak, 2.0 ms) make one unimodal pulse (no dip: the second
+    lands on the first's rise), but no single fruit's force law fits it (it misses by several % of the peak
+    beyond the noise, above analysis.MISFIT_LIMIT's 1.8 %), and the joint fit started from the grid of pulse
+    pairs (signals/split.py) tells them apart: two reports, each onset within 0.1 ms of its fruit's, peaks
+    within 4 % (the joint covariance gives the second ≤ 2 % sd here; 6 seeds gave ≤ 3 %), stiffness within
+    8 % (it also rests on the tail, which lies under the other pulse)."""
     a = impact()
     b = impact(mass=0.7 * MASS)
-    first, second = _reports(_signal([0.1, 0.1015], [a, b], 6000, seed=seed))
-    for report, imp, onset in ((first, a, 0.1), (second, b, 0.1015)):
+    first, second = _reports(_signal([0.1, 0.1 + gap], [a, b], 6000, seed=seed))
+    for report, imp, onset in ((first, a, 0.1), (second, b, 0.1 + gap)):
         assert report["status"] == "ok" and "two fruit in one contact" in report["message"]
         assert report["start_time"] == pytest.approx(onset, abs=1e-4)
-        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.08)
+        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.04)
         assert report["stiffness"] == pytest.approx(imp["K"], rel=0.08)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_two_fruit_whose_pulses_the_samples_cannot_separate_are_one_overlap(seed):
+    """Two fruit 1.5 ms apart: two pulses fit, but the samples fix the second one's peak only to ±5–6 % (the
+    joint fit's standard error; errors of 1–7 % were seen), above analysis.PIECE_PRECISION's 3 %: one report
+    with status "overlap", no firmness, no class: never two grades the data do not support, never one fruit
+    fitted through both."""
+    a = impact()
+    b = impact(mass=0.7 * MASS)
+    (report,) = _reports(_signal([0.1, 0.1015], [a, b], 6000, seed=seed))
+    assert report["status"] == "overlap" and "could not be told apart" in report["message"]
+    assert math.isnan(report["firmness_c"]) and "stiffness" not in report or report.get("stiffness") is None
 
 
 def _fruit_then_rebound_with_the_next(gap, next_mass, seed=5):
@@ -261,31 +275,33 @@ def _fruit_then_rebound_with_the_next(gap, next_mass, seed=5):
     return a, rebound, b, landing, _signal([0.1, landing - gap, landing], [a, b, rebound], 10000, seed=seed)
 
 
+@pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("gap", [1.2e-3, -1.0e-3])
-def test_a_rebound_and_the_next_fruit_landing_together_are_told_apart(gap):
+def test_a_rebound_and_the_next_fruit_landing_together_are_told_apart(gap, seed):
     """The previous fruit's rebound is due (its flight 2 e V/g from its own measured e and the line's V) and the
     next fruit lands 1–1.2 ms from it: one smooth pulse that one force law fits within the misfit limit, but
     two pulses fit it far better (rebounds.rebounds_due, analysis.SPLIT_GAIN), so it is split: the rebound is
-    the first fruit's (rebound_of), the next fruit a new one, each peak within 8 % (as above: overlapping
-    rises) and the new fruit's stiffness within 8 %."""
-    a, rebound, b, landing, x = _fruit_then_rebound_with_the_next(gap, 1.1)
+    the first fruit's (rebound_of), the next fruit a new one.  Tolerances from 30 seeds per gap (max seen in
+    brackets): onsets 0.2 ms (0.1), the new fruit's peak 7 % (6.0 %) and stiffness 10 % (8.1 %), the rebound's
+    peak 15 % (13 %: drawn toward the peak physics expects within that expectation's own ±12 % sd)."""
+    a, rebound, b, landing, x = _fruit_then_rebound_with_the_next(gap, 1.1, seed=seed)
     first, *rest = _reports(x)
     assert first["status"] == "ok" and not first["rebound"]
     assert len(rest) == 2 and all("two fruit in one contact" in r["message"] for r in rest)
     (back,) = [r for r in rest if r["rebound"]]
     (new,) = [r for r in rest if not r["rebound"]]
     assert back["rebound_of"] == first["sequence"]
-    assert back["start_time"] == pytest.approx(landing, abs=1e-4)
-    assert new["start_time"] == pytest.approx(landing - gap, abs=1e-4)
-    assert back["peak_force"] == pytest.approx(rebound["F"], rel=0.08)
-    assert new["peak_force"] == pytest.approx(b["F"], rel=0.08)
-    assert new["stiffness"] == pytest.approx(b["K"], rel=0.08)
+    assert back["start_time"] == pytest.approx(landing, abs=2e-4)
+    assert new["start_time"] == pytest.approx(landing - gap, abs=2e-4)
+    assert back["peak_force"] == pytest.approx(rebound["F"], rel=0.15)
+    assert new["peak_force"] == pytest.approx(b["F"], rel=0.07)
+    assert new["stiffness"] == pytest.approx(b["K"], rel=0.10)
 
 
 def test_a_fruit_alone_where_a_rebound_is_due_stays_one_fruit():
-    """A fruit landing alone where the previous fruit's rebound is due (a pad caught that rebound): two pulses
-    fit it no better than one (its residual is the noise), so it is one new fruit, not split, peak within
-    1 % and stiffness within 3 % (the single-pulse precision of tests/test_signals_fit.py)."""
+    """A fruit landing alone where the previous fruit's rebound is due (a pad caught that rebound): its single
+    fit leaves only the noise, so no joint fit is even tried (analysis._may_split), and it is one new fruit,
+    peak within 1 % and stiffness within 3 % (the single-pulse precision of tests/test_signals_fit.py)."""
     a = impact()
     b = impact(mass=1.1 * MASS, restitution=0.5)
     landing = 0.1 + a["T"] + 2 * a["e"] * V_LINE / G
@@ -315,6 +331,31 @@ def test_a_fruit_and_two_rebounds_landing_together_are_three_contacts(seed):
         assert report["start_time"] == pytest.approx(onset, abs=3e-4)
         assert report["peak_force"] == pytest.approx(imp["F"], rel=0.12)
         assert report["rebound_of"] == (None if parent is None else parent["sequence"])
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_a_fruit_and_two_rebounds_never_make_one_fruit_fitted_through_two(seed):
+    """The same contact over 20 seeds (11 of them give the three contacts above): whatever the split, every report
+    that is not an overlap is one pulse: its impulse (∫F dt = m (1 + e) V, what a pulse carries whatever its
+    shape) within 35 % of one of the three, where a fruit fitted through itself and a rebound carries both (58 %
+    more than the fruit) and the pieces seen are within 25 % (a rebound piece is drawn toward the expected
+    rebound within that expectation's spread); a piece in which two pulses stay together is an "overlap"
+    without firmness (analysis._split_further)."""
+    a, b = impact(), impact(mass=0.9 * MASS, restitution=0.5)
+    back_a = impact(velocity=a["e"] * V_LINE, c=a["c"])
+    back_b = impact(mass=0.9 * MASS, velocity=b["e"] * V_LINE, c=b["c"])
+    landing = 0.1 + a["T"] + 2 * a["e"] * V_LINE / G
+    onset_b = landing + 0.0035 - b["T"] - 2 * b["e"] * V_LINE / G
+    c = impact(mass=1.1 * MASS, restitution=0.55)
+    x = _signal([0.1, onset_b, landing - 0.0012, landing, landing + 0.0035], [a, b, c, back_a, back_b], 12000,
+                seed=seed)
+    _, _, *rest = _reports(x)
+    assert rest
+    for report in rest:
+        if report["status"] == "overlap":
+            assert math.isnan(report["firmness_c"]) and report.get("class") is None
+        else:
+            assert min(abs(report["impulse"] / imp["impulse"] - 1) for imp in (c, back_a, back_b)) < 0.35, report
 
 
 def _lane_fruit(count=8, seed=11):

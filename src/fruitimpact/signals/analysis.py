@@ -62,9 +62,16 @@ FIRMNESS_KEYS = ("firmness_c", "firmness_c_star")
 #: Hertz pulse cannot follow plate ringing or hum), 10 fruit and rebounds landing 0–1.5 ms apart gained
 #: 0.22–2.2.  Below it the contact stays one fruit.
 SPLIT_GAIN = 0.2
-#: At most this many earlier contacts whose rebound is due guide a joint fit (the latest first: one fit per start
-#: and per contact; on a line of 10 fruit/s with two rebounds each, 1–3 are due at once).
+#: At most this many earlier contacts whose rebound is due guide a joint fit (the latest first; their hypotheses
+#: share the ``split.FITS`` fits; on a line of 10 fruit/s with two rebounds each, 1–3 are due at once).
 MAX_DUE = 3
+#: Largest relative standard error of a split piece's peak force (from the samples alone, the joint covariance):
+#: beyond it the pieces are not told apart and the contact is one overlap.  Over the line scenarios of
+#: tests/linegen.py, 84 % of pieces are within 3 % (median 0.5 %), with errors of their size (p95 1.9 %); the
+#: others had errors of 5–55 %.
+PIECE_PRECISION = 0.03
+#: Marks a piece of a split in which a third pulse was found but not told apart (``_split_further``).
+HOLDS_TWO = "_holds_two"
 #: Starts fitted when a piece of a split is tried as two pulses again (rare, and it delays the report).
 FITS_AGAIN = 2
 #: Measured new fruit kept per lane: they stand for a fruit hidden in an overlap (``rebounds.judge_unmeasured``).
@@ -151,13 +158,13 @@ class LineAnalyzer:
         self._unmeasured: dict[int, list[tuple]] = {}
         #: per lane: the recent measured new fruit (the lot's typical pulse at the line's speed)
         self._fruit: dict[int, list[PulseSummary]] = {}
-        #: per lane: the number of the next contact (a detected impact holds one or two contacts)
+        #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
         """The dicts of the contacts in one detected impact, in time order (SI; ``public(report)`` is the
-        JSON object): one, or two when two fruit in one contact were told apart (``signals.split``)."""
+        JSON object): one, or two or three when fruit landing together were told apart (``signals.split``)."""
         analysis = self.analysis
         own = isolated(impact)
         report = impact_indices(own, analysis.rate)
@@ -189,21 +196,35 @@ class LineAnalyzer:
         elif status == "ok" and due and shape is not None and shape.get("converged") and _may_split(shape, own):
             parts = self._split(own, due, FITS_DUE, dip=False)
             if parts is not None and _split_gain(shape, parts, own) < SPLIT_GAIN:
-                parts = None
+                parts = None  # one pulse fits as well: one fruit
             elif parts is not None and not self._holds_a_rebound(parts, impact.noise):
                 # two pulses, but neither is the rebound that was due: landing within a fraction of a
                 # millisecond, their onsets and amplitudes trade off; one contact, no firmness, is the honest report
-                status = "overlap"
                 message = (f"two pulses in one contact ({_split_gain(shape, parts, own):.2f} noise variances per "
                            f"sample better fitted as two) that could not be told apart: a fruit and the rebound of "
                            f"#{due[0].sequence} landing together; no firmness")
-                parts = None
+                status, parts = "overlap", None
         if parts is not None:
             parts = self._split_further(parts, due)
+            vague = _imprecise(parts, self._rebounds(parts, impact.noise))
+            if vague is not None:  # two pulses whose amplitudes the samples do not fix: no firmness either
+                status, parts = "overlap", None
+                message = (f"two pulses in one contact that could not be told apart: a piece's peak force is "
+                           f"determined to ±{vague:.0%} only (at most ±{PIECE_PRECISION:.0%}); no firmness")
+        if parts is not None:
             held = "two" if len(parts) == 2 else "three"
-            return [self._contact(piece, impact_indices(piece, analysis.rate), fit, "ok",
-                                  f"one of {held} fruit in one contact, told apart by a joint fit of the pulses")
-                    for piece, fit in parts]
+            reports = []
+            for piece, fit in parts:
+                indices = impact_indices(piece, analysis.rate)
+                if fit.get(HOLDS_TWO):  # a piece in which a third pulse was found but not told apart
+                    indices.update({key: math.nan for key in FIRMNESS_KEYS})
+                    reports.append(self._contact(piece, indices, fit, "overlap",
+                                                 "a piece of a contact holding three pulses, in which two landed "
+                                                 "together and could not be told apart; no firmness"))
+                else:
+                    reports.append(self._contact(piece, indices, fit, "ok", f"one of {held} fruit in one contact, "
+                                                 "told apart by a joint fit of the pulses"))
+            return reports
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
@@ -216,30 +237,44 @@ class LineAnalyzer:
 
     def _split_further(self, parts, due: list[PulseSummary]):
         """The pieces of a split, one of them split again where it holds a third pulse: when more than one earlier
-        contact's rebound is due (a fruit and two rebounds landing together), a piece (its samples less the other
-        piece's pulse) that two pulses fit better by ``SPLIT_GAIN`` and that holds a rebound becomes two."""
+        contact's rebound is due (a fruit and two rebounds landing together), a piece that is no rebound itself
+        (its samples less the other piece's pulse), that two pulses fit better by ``SPLIT_GAIN`` and that holds a
+        rebound becomes two; one that two pulses fit better but holds none is marked ``HOLDS_TWO`` (reported as
+        an overlap: never one fruit fitted through two)."""
         if len(due) < 2 or not _may_split(parts[0][1], parts[0][0]):  # the joint fit left only the noise
             return parts
         for k, (piece, fit) in enumerate(parts):
             if self._holds_a_rebound([(piece, fit)], piece.noise):
                 continue  # a rebound of its own: the third pulse is in the other piece
             again = self._split(piece, due, FITS_AGAIN, dip=False)
-            if again is None or _split_gain(fit, again, piece) < SPLIT_GAIN or not self._holds_a_rebound(again, piece.noise):
+            if again is None or _split_gain(fit, again, piece) < SPLIT_GAIN:
                 continue
-            pieces = [*parts[:k], *again, *parts[k + 1:]]
-            return sorted(pieces, key=lambda part: part[1]["start_time"])
+            flags = self._rebounds(again, piece.noise)
+            if not any(flags) or _imprecise(again, flags) is not None:
+                return [*parts[:k], (piece, {**fit, HOLDS_TWO: True}), *parts[k + 1:]]
+            return sorted([*parts[:k], *again, *parts[k + 1:]], key=lambda part: part[1]["start_time"])
         return parts
 
     def _holds_a_rebound(self, parts, noise: float) -> bool:
-        """Whether one of the pieces of a split is judged the rebound of an earlier contact of its lane
-        (``rebounds.judge`` on the piece's own indices and fit, as ``_contact`` will judge it)."""
-        history = self.history_of(parts[0][0].lane)
+        """Whether one of the pieces of a split is judged the rebound of an earlier contact (``_rebounds``)."""
+        return any(self._rebounds(parts, noise))
+
+    def _rebounds(self, parts, noise: float) -> list[bool]:
+        """Which pieces of a split are judged rebounds of earlier contacts of their lane, as ``_contact`` will
+        judge them: ``rebounds.judge`` on each piece's own indices and fit, in time order, with the feed prior and
+        the last fruit's onset (an earlier piece judged a fruit is the last fruit for the next)."""
+        lane = parts[0][0].lane
+        history, last_fruit = self.history_of(lane), self._last_fruit.get(lane)
+        flags = []
         for piece, fit in parts:
             summary = from_indices(impact_indices(piece, self.analysis.rate), -1, noise, None)
-            if summary is not None and judge(refine(summary, fit), history,
-                                             max_flight=self.analysis.flight_limit).rebound:
-                return True
-        return False
+            rebound = summary is not None and judge(refine(summary, fit), history,
+                                                    max_flight=self.analysis.flight_limit,
+                                                    last_fruit_onset=last_fruit, pitch=self.analysis.pitch).rebound
+            if summary is not None and not rebound:
+                last_fruit = summary.onset
+            flags.append(rebound)
+        return flags
 
     def history_of(self, lane: int) -> list[PulseSummary]:
         """The recent contacts of a lane that a later one could be the rebound of."""
@@ -426,6 +461,16 @@ def _split_gain(shape: dict, parts, impact: DetectedImpact) -> float:
     if not (_finite(one) and _finite(two) and impact.noise > 0):
         return 0.0
     return (one ** 2 - two ** 2) / impact.noise ** 2
+
+
+def _imprecise(parts, rebounds) -> float | None:
+    """The largest relative standard error of the peak force of a piece that is no rebound (``rebounds``: one flag
+    per piece) when it exceeds ``PIECE_PRECISION``, else None: that fruit's amplitude is then not fixed by the
+    samples (its rise overlaps the other's) and no firmness can be read from it.  A rebound piece is not held to
+    it: it is graded with its fruit, and its values are drawn toward the rebound physics expects."""
+    worst = max((fit.get("peak_force_stderr", math.inf) / fit["peak_force"] if fit.get("peak_force") else math.inf
+                 for (_, fit), rebound in zip(parts, rebounds) if not rebound), default=0.0)
+    return worst if not worst <= PIECE_PRECISION else None
 
 
 def _may_split(shape: dict, impact: DetectedImpact) -> bool:

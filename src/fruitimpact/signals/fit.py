@@ -378,8 +378,8 @@ def _damping_update(cost, cost_trial, predicted, lam, nu):
         rho = (cost - cost_trial) / predicted if predicted > 0.0 else 1.0
         return True, lam * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 2.0, False
     lam, nu = lam * nu, nu * 2.0
-    # no decrease even for vanishing steps: θ is a (projected) minimum
-    return False, lam, nu, lam > 1e16 or predicted <= 1e-14 * cost
+    # no decrease even for vanishing steps: θ is a (projected) minimum (never at a non-finite cost)
+    return False, lam, nu, math.isfinite(cost) and (lam > 1e16 or predicted <= 1e-14 * cost)
 
 
 def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,),
@@ -525,7 +525,8 @@ def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_
     """``levenberg_marquardt`` for a sum of pulses with Gaussian priors on some parameters, compiled: the same
     scaling, damping update, projection of each x on [0, x_max] and stopping rules.  Returns (θ, weighted
     Jacobian, weighted residuals, iterations, status): status 1 converged, 0 iteration limit, −1 the model
-    does not depend on every parameter, −2 the normal equations are singular."""
+    does not depend on every parameter, −2 the normal equations are singular, −3 the start's residuals are not
+    finite."""
     n, m = t.shape[0], theta.shape[0]
     rows = n + prior_index.shape[0]
     a_c, da_c = np.empty(THETA_NODES), np.empty(THETA_NODES)
@@ -536,6 +537,8 @@ def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_
     _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, True,
                    a_c, da_c, part, part_jac)
     cost = _dot(r, r)
+    if not math.isfinite(cost):  # where levenberg_marquardt's math.exp overflows
+        return theta, jac, r, 0, -3
     lam, nu = 1e-3, 2.0
     step = np.empty(m)
     a, g = np.empty((m, m)), np.empty(m)
@@ -593,7 +596,7 @@ def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_
                 singular = True
                 break
             sd = math.sqrt(abs(column[k]) * cost / max(rows - m, 1)) / scale[k]
-            if abs(step[k]) > step_tolerance * sd:
+            if not abs(step[k]) <= step_tolerance * sd:  # a NaN sd is not a small step
                 small = False
         if singular:
             small = step_tolerance * 0.0 >= np.max(np.abs(step))
@@ -617,7 +620,7 @@ def fit_pulse_sum(t, y, weights, theta, prior_index=None, prior_mean=None, prior
         empty_f if prior_mean is None else np.asarray(prior_mean, float),
         empty_f if prior_weight is None else np.asarray(prior_weight, float),
         int(max_iterations), STEP_TOLERANCE, X_MAX)
-    return theta, jac, r, iterations, status == 1
+    return theta, jac, r, iterations, status == 1 and bool(np.all(np.isfinite(theta)))
 
 
 # ---------------------------------------------------------------------------------------------------------
