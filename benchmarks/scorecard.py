@@ -140,7 +140,7 @@ def confusion_text(g: dict, markdown: bool = False) -> str:
                f"{g['clear']}: right {g['clear_right']} = {g['clear_accuracy']:.1%} "
                f"(goal ≥ {lg.GRADING_GOAL:.0%}) {'✓' if ok else '✗'}; ungraded {g['ungraded']}; "
                f"overlapped first contacts {g['overlapped']} (of their {g['overlapped_clear']} clear fruit, "
-               f"{g['overlapped_right']} right)")
+               f"{g['overlapped_right']} right, {g['overlapped_wrong']} wrong)")
     return body + ("\n\n" if markdown else "\n") + summary
 
 

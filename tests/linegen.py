@@ -694,7 +694,7 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
     clear = right = ungraded = 0
     wrong = []
     contacts = truth["contacts"]
-    overlapped = overlapped_clear = overlapped_right = 0
+    overlapped = overlapped_clear = overlapped_right = overlapped_wrong = 0
     for f in truth["fruit"]:
         first = contacts[f["contacts"][0]]
         report = report_of.get(first["index"])
@@ -706,6 +706,7 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
             if np.all(np.abs(f["modulus"] / thresholds - 1.0) >= margin):
                 overlapped_clear += 1
                 overlapped_right += got == f["class"]
+                overlapped_wrong += got is not None and got != f["class"]
             continue
         if np.all(np.abs(f["modulus"] / thresholds - 1.0) >= margin):
             clear += 1
@@ -716,7 +717,8 @@ def grade(reports: list[dict], truth: dict, margin: float = 0.05, window: float 
                                   reported_rebound=None if report is None else report.get("rebound")))
     return dict(fruit=len(truth["fruit"]), confusion=confusion, clear=clear, clear_right=right,
                 clear_accuracy=right / clear if clear else float("nan"), ungraded=ungraded, overlapped=overlapped,
-                overlapped_clear=overlapped_clear, overlapped_right=overlapped_right, wrong=wrong)
+                overlapped_clear=overlapped_clear, overlapped_right=overlapped_right, overlapped_wrong=overlapped_wrong,
+                wrong=wrong)
 
 
 __all__ = ["APPLE", "CLASSES", "EXTENSION", "FruitKind", "G", "GOALS", "GRADED_APPLE", "GRADING_GOAL",

@@ -474,10 +474,12 @@ def _imprecise(parts, rebounds) -> float | None:
 
 
 def _may_split(shape: dict, impact: DetectedImpact) -> bool:
-    """Whether two pulses could fit the contact better than one by ``SPLIT_GAIN``: a fit cannot remove the noise
-    (its residual stays at ~(1 − 8/n) σ², ≥ 0.95 σ² over a contact's ≥ 160 samples), so a single fit whose
-    residual is below (0.95 + ``SPLIT_GAIN``) σ² leaves nothing for a second pulse to take (the joint fits are
-    then not tried: 93 % of single fruit where a rebound is due, on the line scenarios of tests/linegen.py)."""
+    """Whether two pulses might fit the contact better than one by ``SPLIT_GAIN``, a screen before the joint fits
+    (each costs ~1 ms): a second pulse only removes structure, not the noise, so a single fit whose residual is
+    below (0.95 + ``SPLIT_GAIN``) σ² leaves little for it.  Statistical, not a bound (χ²/n scatters by √(2/n),
+    ~0.09 over a contact): on the line scenarios of tests/linegen.py it skipped 93 % of the single fruit where a
+    rebound was due and none of the fruit and rebounds that were then told apart (their single fits left
+    ≥ 1.2 σ²)."""
     residual = shape.get("fit_residual", math.nan)
     return _finite(residual) and impact.noise > 0 and residual ** 2 >= (0.95 + SPLIT_GAIN) * impact.noise ** 2
 
