@@ -427,7 +427,7 @@ def test_a_sum_of_two_noise_free_pulses_is_recovered():
 
     t, force, truth = _two_pulses(0.0)
     start = truth * np.array([1, 1, 1, 1.1, 1.05, 1, 1, 0.9]) + np.array([2e-5, 0.05, -0.05, 0, 0, -0.08, 0.05, 0])
-    theta, _, _, _, converged = fit_pulse_sum(t, force, np.full(t.size, 1.0), start)
+    theta, _, _, _, converged, _ = fit_pulse_sum(t, force, np.full(t.size, 1.0), start)
     assert converged
     assert np.allclose(theta, truth, rtol=1e-5, atol=1e-8), theta - truth
 
@@ -455,6 +455,6 @@ def test_the_compiled_sum_fit_agrees_with_levenberg_marquardt():
 
     expected, *_, converged = levenberg_marquardt(model, np.concatenate([force, mean]), start.copy(),
                                                   np.concatenate([weights, weight]), bounded=(3, 7))
-    theta, *_, compiled_converged = fit_pulse_sum(t, force, weights, start, index, mean, weight)
+    theta, *_, compiled_converged, _ = fit_pulse_sum(t, force, weights, start, index, mean, weight)
     assert converged and compiled_converged
     assert np.allclose(theta, expected, rtol=1e-6, atol=1e-9), theta - expected

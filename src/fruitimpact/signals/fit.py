@@ -609,8 +609,8 @@ def fit_pulse_sum(t, y, weights, theta, prior_index=None, prior_mean=None, prior
                   max_iterations: int = MAX_ITERATIONS):
     """Least squares of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) to samples ``y`` [N] at times
     ``t`` [s] with ``weights`` (1/σ), and Gaussian priors (extra rows (θ[prior_index] − prior_mean) ·
-    prior_weight): the compiled form of ``levenberg_marquardt`` with the pulse model.  Returns (θ, weighted
-    Jacobian, weighted residuals, iterations, converged)."""
+    prior_weight): the compiled form of ``levenberg_marquardt`` with the pulse model.  Returns what it returns:
+    (θ, weighted Jacobian, weighted residuals, iterations, converged, message)."""
     coefficients, width = _shape_table()
     empty_i, empty_f = np.empty(0, np.int64), np.empty(0)
     theta, jac, r, iterations, status = _lm_pulse_sum(
@@ -620,7 +620,14 @@ def fit_pulse_sum(t, y, weights, theta, prior_index=None, prior_mean=None, prior
         empty_f if prior_mean is None else np.asarray(prior_mean, float),
         empty_f if prior_weight is None else np.asarray(prior_weight, float),
         int(max_iterations), STEP_TOLERANCE, X_MAX)
-    return theta, jac, r, iterations, status == 1 and bool(np.all(np.isfinite(theta)))
+    converged = status == 1 and bool(np.all(np.isfinite(theta)))
+    return theta, jac, r, iterations, converged, _LM_MESSAGES.get(status, "converged" if converged else
+                                                                   "the fit left the range of double precision")
+
+
+#: The messages of ``levenberg_marquardt`` for the compiled fit's status codes.
+_LM_MESSAGES = {0: "the iteration limit was reached", -1: "the model does not depend on every parameter here",
+                -2: "the normal equations are singular", -3: "the start's residuals are not finite"}
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -846,7 +853,11 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
     if theta is None:
         return _empty_result(message)
     with np.errstate(over="ignore", invalid="ignore"):  # a far trial step is rejected, not worth a warning
-        theta, jac, r, iterations, converged, message = levenberg_marquardt(model, ys, theta, weights)
+        if terms:
+            theta, jac, r, iterations, converged, message = levenberg_marquardt(model, ys, theta, weights)
+        else:  # the same iteration compiled (one pulse: ~1 ms less per contact on a sorting line)
+            theta, jac, r, iterations, converged, message = fit_pulse_sum(
+                ts, ys, weights if weights is not None else np.ones(ts.size), theta)
 
     t0, duration, x = theta[0], math.exp(theta[2]), theta[3]
     inside = int(np.count_nonzero((ts > t0) & (ts < t0 + duration)))

@@ -192,7 +192,7 @@ def _separated(model, ts, y, noise, weights, theta, args, t_ref, prior=None):
     """(χ², misfit, θ, covariance, rms, iterations) of the joint fit started at ``theta`` when it is accepted
     (module docstring), else None."""
     with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
-        theta, jac, _, iterations, converged = fit_pulse_sum(
+        theta, jac, _, iterations, converged, _ = fit_pulse_sum(
             ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
             max_iterations=SPLIT_ITERATIONS)
     if not np.all(np.isfinite(theta)):
