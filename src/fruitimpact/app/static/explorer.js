@@ -18,15 +18,6 @@ const lengthText = (h) => {
   return r >= 1 ? `${fmt(r, 3)} m` : r >= 0.01 ? `${fmt(r * 100, 3)} cm` : `${fmt(r * 1000, 3)} mm`;
 };
 
-function fill(select, items, selected) {
-  select.replaceChildren(...items.map((item) => {
-    const name = typeof item === "string" ? item : item.name;
-    const option = new Option(name, name, false, name === selected);
-    if (item.description) option.title = item.description;
-    return option;
-  }));
-}
-
 function describe(kind) {
   const name = form.elements[kind].value;
   const item = options[kind === "fruit" ? "fruits" : "surfaces"].find((entry) => entry.name === name);
@@ -84,11 +75,6 @@ function showError(message, argument) {
   statusLine.textContent = "input refused";
 }
 
-async function post(path, body) {
-  const response = await fetch(path, {method: "POST", headers: {"Content-Type": "application/json"}, body: JSON.stringify(body)});
-  return [response.status, await response.json()];
-}
-
 function schedule(delay = 60) {
   clearTimeout(timer);
   const started = performance.now();
@@ -100,7 +86,7 @@ async function update(started) {
   statusLine.textContent = "computing…";
   let status, body;
   try {
-    [status, body] = await post("/api/explore", request());
+    [status, body] = await postJSON("/api/explore", request());
   } catch (error) {
     if (mine === sequence) statusLine.textContent = `the server did not answer (${error})`;
     return;
@@ -211,7 +197,7 @@ async function risk() {
   button.disabled = true;
   button.textContent = "computing…";
   try {
-    const [status, body] = await post("/api/risk", request());
+    const [status, body] = await postJSON("/api/risk", request());
     const svg = document.getElementById("chart-risk");
     if (status !== 200 || body.refused) { clearErrors(); showError(body.error, body.argument); return; }
     svg.removeAttribute("hidden");  // an SVG element has no `hidden` property

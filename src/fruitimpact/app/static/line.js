@@ -21,15 +21,6 @@ const make = (tag, props = {}, children = []) => {
   return node;
 };
 
-function fill(select, items, selected) {
-  select.replaceChildren(...items.map((item) => {
-    const name = typeof item === "string" ? item : item.name;
-    const option = new Option(item.label || name, name, false, name === selected);
-    if (item.description) option.title = item.description;
-    return option;
-  }));
-}
-
 // ------------------------------------------------------------------------------------------ the line's table
 function rows() { return [...body.querySelectorAll("tr.point")]; }
 
@@ -124,11 +115,6 @@ function request() {
   return out;
 }
 
-async function post(path, payload) {
-  const response = await fetch(path, {method: "POST", headers: {"Content-Type": "application/json"}, body: JSON.stringify(payload)});
-  return [response.status, await response.json()];
-}
-
 // An edit asks for an audit after `delay` ms; one audit at a time: an edit made meanwhile sends the next one
 // when it returns, and an answer an edit has overtaken (sent, or waiting for its delay) is not drawn.
 function schedule(delay) {
@@ -143,7 +129,7 @@ async function send() {
   statusLine.textContent = "computing…";
   let status, answer;
   try {
-    [status, answer] = await post("/api/line", request());
+    [status, answer] = await postJSON("/api/line", request());
   } catch (error) {
     statusLine.textContent = `the server did not answer (${error})`;
     answer = null;
@@ -438,7 +424,7 @@ function onTableClick(event) {
 async function start() {
   let status, answer;
   try {
-    [status, answer] = await post("/api/line", {});  // the example line, with the page's defaults
+    [status, answer] = await postJSON("/api/line", {});  // the example line, with the page's defaults
   } catch (error) {
     statusLine.textContent = `the server did not answer (${error})`;
     return;

@@ -5,6 +5,22 @@
 const fmt = (v, digits = 4) => v === null || v === undefined || !Number.isFinite(v) ? "–" : Number(v.toPrecision(digits)).toLocaleString("en-US", {maximumSignificantDigits: digits});
 const mb = (bytes) => `${(bytes / 1048576).toLocaleString("en-US", {maximumFractionDigits: 1})} MB`;
 
+// Fill a <select> with `items` (names, or {name, label, description}), `selected` chosen.
+function fill(select, items, selected) {
+  select.replaceChildren(...items.map((item) => {
+    const name = typeof item === "string" ? item : item.name;
+    const option = new Option(item.label || name, name, false, name === selected);
+    if (item.description) option.title = item.description;
+    return option;
+  }));
+}
+
+// POST `body` as JSON: [HTTP status, the answer's JSON].
+async function postJSON(path, body) {
+  const response = await fetch(path, {method: "POST", headers: {"Content-Type": "application/json"}, body: JSON.stringify(body)});
+  return [response.status, await response.json()];
+}
+
 // Save a Blob as a file the browser downloads.
 function download(name, blob) {
   const link = Object.assign(document.createElement("a"), {href: URL.createObjectURL(blob), download: name});

@@ -42,10 +42,10 @@ function refuse(body) {
   statusLine.textContent = "refused: see the form";
 }
 
+// The answer, or a refusal when the server answered with an HTTP error.
 async function post(path, body) {
-  const response = await fetch(path, {method: "POST", body: JSON.stringify(body), headers: {"Content-Type": "application/json"}});
-  const answer = await response.json();
-  if (!response.ok) return {refused: true, error: answer.error || `the server answered ${response.status}`, argument: null};
+  const [status, answer] = await postJSON(path, body);
+  if (!(status >= 200 && status < 300)) return {refused: true, error: answer.error || `the server answered ${status}`, argument: null};
   return answer;
 }
 
