@@ -30,6 +30,7 @@ from fruitimpact.engine.powerlaw import (
 )
 from fruitimpact.signals import fit as fitmod
 from fruitimpact.signals.fit import fit_impact
+from fruitimpact.signals.pulse import X_MAX, PulseModel
 
 RATE = 20_000.0
 
@@ -58,10 +59,10 @@ def scipy_table(row):
     from scipy.optimize import least_squares
 
     t, y = row["time"] - row["time"][0], row["force"]
-    model = fitmod.PulseModel(np.ascontiguousarray(t))
+    model = PulseModel(np.ascontiguousarray(t))
     start, _ = fitmod._start(t, y, model, None)
     sol = least_squares(lambda p: model(p) - y, start, jac=lambda p: model(p, True)[1],
-                        bounds=([-np.inf, -np.inf, -np.inf, 0.0], [np.inf, np.inf, np.inf, fitmod.X_MAX]),
+                        bounds=([-np.inf, -np.inf, -np.inf, 0.0], [np.inf, np.inf, np.inf, X_MAX]),
                         x_scale="jac", xtol=1e-10, ftol=1e-10)
     return fitmod.derived(sol.x, row["velocity"], None, None, None)[0], sol.nfev
 
@@ -71,7 +72,7 @@ def scipy_exact(row):
     from scipy.optimize import least_squares
 
     t, y, v = row["time"] - row["time"][0], row["force"], row["velocity"]
-    model = fitmod.PulseModel(np.ascontiguousarray(t))
+    model = PulseModel(np.ascontiguousarray(t))
     start, _ = fitmod._start(t, y, model, None)
     derived = fitmod.derived(start, v, None, None, None)
     p0 = [start[0], math.log(derived[0]), math.log(derived[2]), start[3]]

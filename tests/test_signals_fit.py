@@ -20,12 +20,8 @@ from fruitimpact.engine.powerlaw import (
     powerlaw_single,
     x_of_restitution,
 )
-from fruitimpact.signals.fit import (
-    RESULT_KEYS,
-    fit_impact,
-    model_curve,
-    shape_table_error,
-)
+from fruitimpact.signals.fit import RESULT_KEYS, fit_impact, model_curve
+from fruitimpact.signals.pulse import shape_table_error
 
 RATE = 20_000.0  # Hz
 # an apple: 200 g, 75 mm, E = 3 MPa, ν = 0.35, dropped 5.1 cm (V = 1 m/s), e = 0.5
@@ -420,10 +416,10 @@ def _two_pulses(noise, seed=2, gap=1.5e-3):
 
 
 def test_a_sum_of_two_noise_free_pulses_is_recovered():
-    """The compiled least squares of a sum of pulses (fit.fit_pulse_sum, used by signals.split) against the
+    """The compiled least squares of a sum of pulses (leastsquares.fit_pulse_sum, used by signals.split) against the
     exact engine's own pulses, 1.5 ms apart, started 5-10 % off: every parameter back to 1e-5 (the table's
     accuracy is 7.5e-8 of F_max; x and ln T are the least determined, by the pulses' weak tails)."""
-    from fruitimpact.signals.fit import fit_pulse_sum
+    from fruitimpact.signals.leastsquares import fit_pulse_sum
 
     t, force, truth = _two_pulses(0.0)
     start = truth * np.array([1, 1, 1, 1.1, 1.05, 1, 1, 0.9]) + np.array([2e-5, 0.05, -0.05, 0, 0, -0.08, 0.05, 0])
@@ -433,10 +429,11 @@ def test_a_sum_of_two_noise_free_pulses_is_recovered():
 
 
 def test_the_compiled_sum_fit_agrees_with_levenberg_marquardt():
-    """fit.fit_pulse_sum is levenberg_marquardt (the one-pulse fit's NumPy loop) compiled for a sum of pulses:
+    """leastsquares.fit_pulse_sum is levenberg_marquardt (the one-pulse fit's NumPy loop) compiled for a sum of pulses:
     on the same noisy data from the same start the two reach the same optimum (1e-6: their sums are taken in
     another order), priors included (extra rows (θ_k − μ)/sd in both)."""
-    from fruitimpact.signals.fit import PulseModel, fit_pulse_sum, levenberg_marquardt
+    from fruitimpact.signals.leastsquares import fit_pulse_sum, levenberg_marquardt
+    from fruitimpact.signals.pulse import PulseModel
 
     t, force, truth = _two_pulses(0.01)
     start = truth + np.array([1e-5, 0.05, -0.05, 0.1, -1e-5, -0.08, 0.05, -0.05])

@@ -12,8 +12,8 @@ Poisson's ratio ν the modulus follows from Hertz on a rigid plate: E = (1 − �
 
 Parametrisation
 ---------------
-The least-squares fit (Levenberg–Marquardt in NumPy: Marquardt's diagonal scaling, Nielsen's
-damping update, analytic Jacobian) runs in
+The least-squares fit (``signals.leastsquares``: Levenberg–Marquardt with Marquardt's diagonal scaling,
+Nielsen's damping update and the analytic Jacobian of ``signals.pulse``) runs in
 
     θ = (t0, ln F_max, ln T, x),   F(t) = F_max · H((t − t0)/T; x),
 
@@ -23,27 +23,15 @@ orthogonal to the others (correlations ≤ 0.5; ln T and x stay correlated, ~0.9
 the weak tail carries both), and x = c·V is kept in [0, X_MAX] by projection (e from 1 down to
 e(X_MAX) ≈ 0.1).  The start comes from the raw indices: the (3-point smoothed) peak and the two
 half-maximum crossings fix t0 and T for each x of a grid, and the x with the least squared residual
-wins.  The iteration stops when every step is below ``STEP_TOLERANCE`` of its parameter's standard
-error (with noise, Gauss–Newton converges only linearly near the optimum; the last digits are noise).
+wins.  The iteration stops when every step is below ``leastsquares.STEP_TOLERANCE`` of its parameter's
+standard error (with noise, Gauss–Newton converges only linearly near the optimum; the last digits are noise).
 Optionally (``baseline=``) a constant or a linear residual baseline is fitted alongside.
 
+H is tabulated once per process from the exact engine (``signals.pulse``: at most 1e-7 of F_max off).
 Everything reported is derived from θ with the exact engine (``powerlaw_single``); the standard
 errors are the covariance s² (JᵀJ)⁻¹ (s² the residual variance; or (Jᵀ W J)⁻¹ with a given noise)
 pushed through the Jacobian of that map (central differences).  They assume white noise: structured
 residuals (ringing, hum) make them optimistic.
-
-The pulse shape table
----------------------
-The exact engine's ``powerlaw_curves`` costs ~6 µs per sample (one Newton inversion of a
-Gauss–Jacobi time integral each), i.e. ~2 ms for a 300-sample window and twice that with a Jacobian
-in x: too slow for a 10 ms budget over several iterations.  So H is tabulated once per process
-(~0.25 s, on first use) from the exact engine: in the angle θ with σ = (1 − cos θ)/2, H is analytic
-on [0, π] (the τ^1.5 onset and (T − τ)^1.5 separation become smooth in √σ and √(1 − σ)), so a
-Chebyshev series of ``THETA_NODES`` terms in θ represents it; its coefficients are in turn piecewise
-Chebyshev series in ln(1 + x).  ``shape_table_error`` measures the table against the exact engine
-at random (σ, x): at most 1e-7 of F_max over x ∈ [0, X_MAX] (the worst near X_MAX; ~1e-9 for
-e ≥ 0.3), five orders below a 1 % noise.  The reported quantities and ``model_curve`` use the exact
-engine, not the table.
 
 Accuracy (tests/test_signals_fit.py; apple, T = 7.9 ms, 20 kHz, 1 % noise, 50 seeds): given V,
 K ±1.2 % (stderr 1.1 %, the Cramér–Rao limit; 94 % of seeds within 2 %), e ±0.006, m ±0.5 %;
@@ -55,36 +43,20 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 
 from fruitimpact.engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
-from fruitimpact.engine.powerlaw import (
-    powerlaw_characteristics,
-    powerlaw_curves,
-    powerlaw_curves_batch,
-    powerlaw_single,
-)
-from fruitimpact.signals.filters import solve_small
+from fruitimpact.engine.powerlaw import powerlaw_curves, powerlaw_single
+from fruitimpact.signals.leastsquares import fit_pulse_sum, levenberg_marquardt
+from fruitimpact.signals.pulse import STIFFNESS_SCALE, X_MAX, PulseModel, shape_table, table_shape
 
-# The public names; PulseModel, fit_pulse_sum, derived and named_result also serve split.py.
-__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "X_MAX", "at_velocity", "fit_impact", "model_curve", "prepare",
-           "shape_table_error"]
+# The public names; derived and named_result also serve split.py.
+__all__ = ["MIN_CONTACT_SAMPLES", "RESULT_KEYS", "at_velocity", "fit_impact", "model_curve", "prepare"]
 
-#: Largest x = c·V the fit explores (e ≈ 0.100); the projection keeps x in [0, X_MAX].
-X_MAX = 10.0
-#: Chebyshev terms of H in the angle θ (error ~1e-7 at x = X_MAX, ~1e-9 for e > 0.3).
-THETA_NODES = 64
-#: Panels in ln(1 + x) and Chebyshev terms per panel for the x dependence of the θ coefficients.
-X_PANELS = 10
-X_DEGREE = 12
 #: Fewer (unmasked) samples than this inside the fitted contact: converged = False.
 MIN_CONTACT_SAMPLES = 8
 #: A peak below this many noise standard deviations is no pulse.
 MIN_PEAK_SNR = 5.0
-MAX_ITERATIONS = 100
-#: The iteration stops when every parameter's step is below this fraction of its standard error.
-STEP_TOLERANCE = 1e-3
 
 _FIT_NAMES = ("stiffness", "restitution", "mass", "velocity", "damping_factor", "modulus", "start_time",
               "peak_force", "time_to_peak", "contact_duration", "firmness_c", "firmness_c_star", "impulse")
@@ -93,194 +65,6 @@ RESULT_KEYS = _FIT_NAMES + tuple(name + "_stderr" for name in _FIT_NAMES) + (
     "fit_residual", "fit_residual_relative", "noise", "samples_in_contact", "converged", "iterations", "message")
 
 _BASELINE_TERMS = {None: 0, "none": 0, "offset": 1, "linear": 2}
-_STIFFNESS_SCALE = 1.25  # (n + 1)/2: with m = V = 1 and K = 1.25 the Hertz scales δ_H = t_H = 1
-_TABLE: list = []
-
-
-# ---------------------------------------------------------------------------------------------------------
-# The pulse-shape table H(σ; x)
-
-def _chebyshev_transform(values: np.ndarray, axis: int) -> np.ndarray:
-    """Chebyshev coefficients from values at the first-kind points cos(π (i + ½)/N), along ``axis``."""
-    n = values.shape[axis]
-    i = np.arange(n)
-    basis = np.cos(np.pi * np.outer(np.arange(n), i + 0.5) / n) * (2.0 / n)  # [k, i]
-    basis[0] *= 0.5
-    return np.moveaxis(np.tensordot(basis, np.moveaxis(values, axis, 0), axes=(1, 0)), 0, axis)
-
-
-def _exact_shape(x: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    """H(σ; x) from the exact engine, one row per x: F/F_max at t = σ T(x)."""
-    x = np.asarray(x, dtype=float)
-    ones = np.ones_like(x)
-    chars = powerlaw_characteristics(ones, _STIFFNESS_SCALE * ones, x, ones, ones)
-    times = np.asarray(sigma, dtype=float) * chars[:, CONTACT_DURATION][:, None]
-    force = powerlaw_curves_batch(ones, _STIFFNESS_SCALE * ones, x, ones, times)[2]
-    return force / chars[:, PEAK_FORCE][:, None]
-
-
-def _shape_table() -> tuple[np.ndarray, float]:
-    """(coefficients [panel, k (x), j (θ)], panel width in ln(1 + x)); built once per process."""
-    if _TABLE:
-        return _TABLE[0]
-    width = math.log1p(X_MAX) / X_PANELS
-    x_nodes = np.cos(np.pi * (np.arange(X_DEGREE) + 0.5) / X_DEGREE)
-    u = width * (np.arange(X_PANELS)[:, None] + 0.5 * (1.0 + x_nodes[None, :]))  # [panel, k]
-    theta_nodes = np.cos(np.pi * (np.arange(THETA_NODES) + 0.5) / THETA_NODES)
-    sigma = 0.5 * (1.0 - np.cos(0.5 * np.pi * (theta_nodes + 1.0)))
-    values = _exact_shape(np.expm1(u).ravel(), np.broadcast_to(sigma, (u.size, THETA_NODES)))
-    values = values.reshape(X_PANELS, X_DEGREE, THETA_NODES)
-    coefficients = _chebyshev_transform(_chebyshev_transform(values, 2), 1)
-    _TABLE.append((np.ascontiguousarray(coefficients), width))
-    return _TABLE[0]
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _theta_coefficients(x, coefficients, width, a, da):
-    """Chebyshev coefficients in θ of H(·; x) into ``a`` and their x derivatives into ``da``."""
-    v = math.log1p(x)
-    panel = min(max(int(v / width), 0), coefficients.shape[0] - 1)
-    s = 2.0 * (v / width - panel) - 1.0
-    scale = 2.0 / width / (1.0 + x)  # d s/dx
-    for j in range(coefficients.shape[2]):
-        a[j] = 0.0
-        da[j] = 0.0
-    t_prev, t_cur = 1.0, s  # T_k(s)
-    d_prev, d_cur = 0.0, 1.0  # T_k'(s)
-    for k in range(coefficients.shape[1]):
-        if k == 0:
-            t_k, d_k = 1.0, 0.0
-        elif k == 1:
-            t_k, d_k = s, 1.0
-        else:
-            t_k = 2.0 * s * t_cur - t_prev
-            d_k = 2.0 * t_cur + 2.0 * s * d_cur - d_prev
-            t_prev, t_cur = t_cur, t_k
-            d_prev, d_cur = d_cur, d_k
-        for j in range(coefficients.shape[2]):
-            a[j] += coefficients[panel, k, j] * t_k
-            da[j] += coefficients[panel, k, j] * d_k * scale
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _pulse(t, t0, peak, duration, a, da, model, jacobian):
-    """F = peak · H((t − t0)/duration) at each t (ascending) and, if ``jacobian`` has rows, ∂F/∂(t0, ln peak,
-    ln duration, x) there (H from the θ coefficients ``a``, ∂H/∂x from ``da``).  The Chebyshev recurrences run
-    term by term over all samples of the pulse at once (independent samples: vector instructions), not sample
-    by sample (a chain of dependent operations)."""
-    want = jacobian.shape[0] > 0
-    n_terms = a.shape[0]
-    n = t.shape[0]
-    lo, hi = n, 0
-    for i in range(n):
-        sigma = (t[i] - t0) / duration
-        if 0.0 < sigma < 1.0:
-            lo = min(lo, i)
-            hi = i + 1
-        else:
-            model[i] = 0.0
-            if want:
-                for col in range(4):
-                    jacobian[i, col] = 0.0
-    if hi <= lo:
-        return
-    m = hi - lo
-    sig = np.empty(m)
-    s = np.empty(m)
-    for k in range(m):
-        sig[k] = (t[lo + k] - t0) / duration
-        s[k] = 2.0 * math.acos(1.0 - 2.0 * sig[k]) / math.pi - 1.0
-    if not want:  # the value alone: Clenshaw's recurrence, a third of the work
-        b1 = np.zeros(m)
-        b2 = np.zeros(m)
-        for j in range(n_terms - 1, 0, -1):
-            aj = a[j]
-            for k in range(m):
-                value = 2.0 * s[k] * b1[k] - b2[k] + aj
-                b2[k] = b1[k]
-                b1[k] = value
-        for k in range(m):
-            model[lo + k] = peak * (s[k] * b1[k] - b2[k] + a[0])
-        return
-    h = np.empty(m)
-    hx = np.empty(m)
-    hs = np.empty(m)
-    t_prev, t_cur = np.ones(m), s.copy()
-    d_prev, d_cur = np.zeros(m), np.ones(m)
-    for k in range(m):
-        h[k] = a[0] + a[1] * s[k]
-        hx[k] = da[0] + da[1] * s[k]
-        hs[k] = a[1]
-    for j in range(2, n_terms):
-        aj, daj = a[j], da[j]
-        for k in range(m):
-            t_j = 2.0 * s[k] * t_cur[k] - t_prev[k]
-            d_j = 2.0 * t_cur[k] + 2.0 * s[k] * d_cur[k] - d_prev[k]
-            h[k] += aj * t_j
-            hx[k] += daj * t_j
-            hs[k] += aj * d_j
-            t_prev[k], t_cur[k] = t_cur[k], t_j
-            d_prev[k], d_cur[k] = d_cur[k], d_j
-    for k in range(m):
-        i = lo + k
-        model[i] = peak * h[k]
-        # dH/dσ = dH/ds · (2/π) · dθ/dσ,  dθ/dσ = 1/√(σ(1 − σ))
-        h_sigma = hs[k] * (2.0 / math.pi) / math.sqrt(sig[k] * (1.0 - sig[k]))
-        jacobian[i, 0] = -peak * h_sigma / duration
-        jacobian[i, 1] = model[i]
-        jacobian[i, 2] = -peak * h_sigma * sig[k]
-        jacobian[i, 3] = peak * hx[k]
-
-
-class PulseModel:
-    """The tabulated pulse F(t; θ) on fixed sample times, plus an optional baseline polynomial
-    b0 + b1 u (u = t scaled to [-1, 1] over the window) in θ[4:], with its Jacobian."""
-
-    def __init__(self, t: np.ndarray, baseline_terms: int = 0):
-        self.coefficients, self.width = _shape_table()
-        self.t = t
-        self.terms = baseline_terms
-        self.n_params = 4 + baseline_terms
-        span = t[-1] - t[0] if t.size > 1 else 1.0
-        u = (2.0 * (t - t[0]) / span - 1.0) if t.size > 1 else np.zeros_like(t)
-        self.basis = np.column_stack([u ** k for k in range(baseline_terms)]) if baseline_terms \
-            else np.empty((t.size, 0))
-        self.a = np.empty(THETA_NODES)
-        self.da = np.empty(THETA_NODES)
-        self.model = np.empty_like(t)
-        self.jacobian = np.empty((t.shape[0], 4))
-        self._no_jacobian = np.empty((0, 4))
-
-    def pulse(self, theta, jacobian: bool = False):
-        t0, log_peak, log_duration, x = theta[:4]
-        _theta_coefficients(x, self.coefficients, self.width, self.a, self.da)
-        _pulse(self.t, t0, math.exp(log_peak), math.exp(log_duration), self.a, self.da, self.model,
-               self.jacobian if jacobian else self._no_jacobian)
-        return (self.model, self.jacobian) if jacobian else self.model
-
-    def __call__(self, theta, jacobian: bool = False):
-        """F(t; θ) (a new array) and, if asked, the Jacobian ∂F/∂θ (a new array)."""
-        out = self.pulse(theta, jacobian)
-        model = out[0] if jacobian else out
-        model = model + self.basis @ np.asarray(theta[4:], dtype=float) if self.terms else model.copy()
-        if not jacobian:
-            return model
-        return model, np.hstack([out[1], self.basis]) if self.terms else out[1].copy()
-
-
-def _table_shape(x: float, sigma: np.ndarray) -> np.ndarray:
-    model = PulseModel(np.ascontiguousarray(sigma, dtype=float))
-    return model((0.0, 0.0, 0.0, x))
-
-
-def shape_table_error(samples: int = 400, seed: int = 1) -> float:
-    """Largest |H_table − H_exact| (in units of the peak) at ``samples`` random (σ, x), x ∈ [0, X_MAX]."""
-    rng = np.random.default_rng(seed)
-    x = np.expm1(rng.uniform(0.0, math.log1p(X_MAX), samples))
-    sigma = rng.uniform(0.0, 1.0, (samples, 64))
-    exact = _exact_shape(x, sigma)
-    table = np.array([_table_shape(x[i], sigma[i]) for i in range(samples)])
-    return float(np.max(np.abs(table - exact)))
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -296,7 +80,7 @@ def _start_table() -> np.ndarray:
         sigma = np.linspace(0.0, 1.0, 8001)
         rows = []
         for x in _START_X:
-            h = _table_shape(x, sigma)
+            h = table_shape(x, sigma)
             top = int(np.argmax(h))
             rise = np.interp(0.5, h[:top + 1], sigma[:top + 1])
             fall = np.interp(0.5, h[top:][::-1], sigma[top:][::-1])
@@ -369,284 +153,22 @@ def _start(t, y, model: PulseModel, weights) -> tuple[np.ndarray | None, str]:
 
 
 # ---------------------------------------------------------------------------------------------------------
-# Levenberg–Marquardt
-
-@nb.njit(cache=True)
-def _damping_update(cost, cost_trial, predicted, lam, nu):
-    """One Levenberg–Marquardt damping decision (Nielsen's update): (step accepted, λ, ν, stop at a minimum)."""
-    if cost_trial < cost:
-        rho = (cost - cost_trial) / predicted if predicted > 0.0 else 1.0
-        return True, lam * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 2.0, False
-    lam, nu = lam * nu, nu * 2.0
-    # no decrease even for vanishing steps: θ is a (projected) minimum (never at a non-finite cost)
-    return False, lam, nu, math.isfinite(cost) and (lam > 1e16 or predicted <= 1e-14 * cost)
-
-
-def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, weights, bounded=(3,),
-                        max_iterations: int = MAX_ITERATIONS):
-    """Minimise Σ (w (F(θ) − y))² over θ = (t0, ln F_max, ln T, x, baseline…) with each x (the entries
-    ``bounded``) projected on [0, X_MAX], in at most ``max_iterations``.
-    Marquardt's diagonal scaling, Nielsen's damping update.  Returns (θ, J at θ, residual, iterations,
-    converged, message)."""
-
-    n_params = theta.size
-
-    def evaluate(th, jac=False):
-        out = model(th, jac)
-        if jac:
-            f, j = out
-            r = f - y
-            return (r * weights, j * weights[:, None]) if weights is not None else (r, j)
-        r = out - y
-        return r * weights if weights is not None else r
-
-    r, jac = evaluate(theta, True)
-    cost = float(r @ r)
-    lam, nu = 1e-3, 2.0
-    message = "the iteration limit was reached"
-    converged = False
-    iterations = 0
-    for iterations in range(1, max_iterations + 1):
-        a = jac.T @ jac
-        g = jac.T @ r
-        scale = np.sqrt(np.diag(a))
-        if not np.all(scale > 0.0):
-            return theta, jac, r, iterations, False, "the model does not depend on every parameter here"
-        a_n = a / np.outer(scale, scale)
-        g_n = g / scale
-        accepted = False
-        while not accepted:
-            try:
-                step = -np.linalg.solve(a_n + lam * np.eye(n_params), g_n) / scale
-            except np.linalg.LinAlgError:
-                lam *= nu
-                nu *= 2.0
-                if lam > 1e16:
-                    return theta, jac, r, iterations, False, "the normal equations are singular"
-                continue
-            trial = theta + step
-            for k in bounded:
-                trial[k] = min(max(trial[k], 0.0), X_MAX)
-            step = trial - theta
-            r_trial = evaluate(trial)
-            cost_trial = float(r_trial @ r_trial)
-            predicted = -(2.0 * g @ step + step @ a @ step)  # decrease of the linear model
-            accepted, lam, nu, stop = _damping_update(cost, cost_trial, float(predicted), lam, nu)
-            if stop:
-                return theta, jac, r, iterations, True, "converged"
-        decrease = cost - cost_trial
-        theta = trial
-        r, jac = evaluate(theta, True)
-        cost = float(r @ r)
-        # Stop once the step is far below the parameters' standard errors (with noise the
-        # Gauss–Newton model misses the residual curvature and the last digits come only
-        # linearly), or the cost no longer decreases (noise-free data).
-        try:
-            sd = np.sqrt(np.abs(np.diag(np.linalg.inv(a_n))) * cost / max(y.size - n_params, 1)) / scale
-        except np.linalg.LinAlgError:
-            sd = np.zeros(n_params)
-        if np.all(np.abs(step) <= STEP_TOLERANCE * sd) or decrease <= 1e-12 * cost or cost == 0.0:
-            converged = True
-            message = "converged"
-            break
-    return theta, jac, r, iterations, converged, message
-
-
-@nb.njit(cache=True)
-def _dot(u, v) -> float:
-    """u · v (loops: numba's np.dot needs SciPy's BLAS, which fruitimpact does not require)."""
-    total = 0.0
-    for i in range(u.shape[0]):
-        total += u[i] * v[i]
-    return total
-
-
-@nb.njit(cache=True)
-def _quadratic(a, v) -> float:
-    """v · (a v)."""
-    total = 0.0
-    for i in range(v.shape[0]):
-        for j in range(v.shape[0]):
-            total += v[i] * a[i, j] * v[j]
-    return total
-
-
-@nb.njit(cache=True)
-def _normal_equations(jac, r, a, g):
-    """a = JᵀJ and g = Jᵀr, in place."""
-    rows, m = jac.shape
-    a[:, :] = 0.0
-    g[:] = 0.0
-    for k in range(rows):
-        for i in range(m):
-            ji = jac[k, i]
-            if ji == 0.0:
-                continue
-            g[i] += ji * r[k]
-            for j in range(i, m):
-                a[i, j] += ji * jac[k, j]
-    for i in range(m):
-        for j in range(i):
-            a[i, j] = a[j, i]
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, want,
-                   a, da, part, part_jac):
-    """Weighted residuals of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) and the prior rows, and
-    their Jacobian when ``want``."""
-    n = t.shape[0]
-    pulses = theta.shape[0] // 4
-    for i in range(n):
-        r[i] = 0.0
-    if want:
-        jac[:, :] = 0.0
-    empty = np.empty((0, 4))
-    for p in range(pulses):
-        _theta_coefficients(theta[4 * p + 3], coefficients, width, a, da)
-        _pulse(t, theta[4 * p], math.exp(theta[4 * p + 1]), math.exp(theta[4 * p + 2]), a, da, part,
-               part_jac if want else empty)
-        for i in range(n):
-            r[i] += part[i]
-            if want:
-                for c in range(4):
-                    jac[i, 4 * p + c] = part_jac[i, c] * weights[i]
-    for i in range(n):
-        r[i] = (r[i] - y[i]) * weights[i]
-    for k in range(prior_index.shape[0]):
-        r[n + k] = (theta[prior_index[k]] - prior_mean[k]) * prior_weight[k]
-        if want:
-            jac[n + k, prior_index[k]] = prior_weight[k]
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, max_iterations,
-                  step_tolerance, x_max):
-    """``levenberg_marquardt`` for a sum of pulses with Gaussian priors on some parameters, compiled: the same
-    scaling, damping update, projection of each x on [0, x_max] and stopping rules.  Returns (θ, weighted
-    Jacobian, weighted residuals, iterations, status): status 1 converged, 0 iteration limit, −1 the model
-    does not depend on every parameter, −2 the normal equations are singular, −3 the start's residuals are not
-    finite."""
-    n, m = t.shape[0], theta.shape[0]
-    rows = n + prior_index.shape[0]
-    a_c, da_c = np.empty(THETA_NODES), np.empty(THETA_NODES)
-    part, part_jac = np.empty(n), np.empty((n, 4))
-    r, jac = np.empty(rows), np.empty((rows, m))
-    r_trial, jac_unused = np.empty(rows), np.empty((rows, m))
-    theta = theta.copy()
-    _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, True,
-                   a_c, da_c, part, part_jac)
-    cost = _dot(r, r)
-    if not math.isfinite(cost):  # where levenberg_marquardt's math.exp overflows
-        return theta, jac, r, 0, -3
-    lam, nu = 1e-3, 2.0
-    step = np.empty(m)
-    a, g = np.empty((m, m)), np.empty(m)
-    trial = np.empty(m)
-    a_n = np.empty((m, m))
-    iterations = 0
-    for iterations in range(1, max_iterations + 1):
-        _normal_equations(jac, r, a, g)
-        scale = np.sqrt(np.diag(a))
-        for k in range(m):
-            if not scale[k] > 0.0:
-                return theta, jac, r, iterations, -1
-        for i in range(m):
-            for j in range(m):
-                a_n[i, j] = a[i, j] / (scale[i] * scale[j])
-        g_n = g / scale
-        accepted = False
-        cost_trial = cost
-        while not accepted:
-            damped = a_n.copy()
-            for k in range(m):
-                damped[k, k] += lam
-                step[k] = -g_n[k]
-            if not solve_small(damped, step, m):
-                lam *= nu
-                nu *= 2.0
-                if lam > 1e16:
-                    return theta, jac, r, iterations, -2
-                continue
-            for k in range(m):
-                trial[k] = theta[k] + step[k] / scale[k]
-                if k % 4 == 3:
-                    trial[k] = min(max(trial[k], 0.0), x_max)
-                step[k] = trial[k] - theta[k]
-            _sum_residuals(t, y, weights, trial, coefficients, width, prior_index, prior_mean, prior_weight, r_trial,
-                           jac_unused, False, a_c, da_c, part, part_jac)
-            cost_trial = _dot(r_trial, r_trial)
-            predicted = -(2.0 * _dot(g, step) + _quadratic(a, step))
-            accepted, lam, nu, stop = _damping_update(cost, cost_trial, predicted, lam, nu)
-            if stop:
-                return theta, jac, r, iterations, 1
-        decrease = cost - cost_trial
-        theta[:] = trial
-        _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, True,
-                       a_c, da_c, part, part_jac)
-        cost = _dot(r, r)
-        # the step against the parameters' standard errors, as levenberg_marquardt: diag((A_n)^-1) by columns
-        small = True
-        column = np.empty(m)
-        singular = False
-        for k in range(m):
-            column[:] = 0.0
-            column[k] = 1.0
-            if not solve_small(a_n.copy(), column, m):
-                singular = True
-                break
-            sd = math.sqrt(abs(column[k]) * cost / max(rows - m, 1)) / scale[k]
-            if not abs(step[k]) <= step_tolerance * sd:  # a NaN sd is not a small step
-                small = False
-        if singular:
-            small = step_tolerance * 0.0 >= np.max(np.abs(step))
-        if small or decrease <= 1e-12 * cost or cost == 0.0:
-            return theta, jac, r, iterations, 1
-    return theta, jac, r, iterations, 0
-
-
-def fit_pulse_sum(t, y, weights, theta, prior_index=None, prior_mean=None, prior_weight=None,
-                  max_iterations: int = MAX_ITERATIONS):
-    """Least squares of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) to samples ``y`` [N] at times
-    ``t`` [s] with ``weights`` (1/σ), and Gaussian priors (extra rows (θ[prior_index] − prior_mean) ·
-    prior_weight): the compiled form of ``levenberg_marquardt`` with the pulse model.  Returns what it returns:
-    (θ, weighted Jacobian, weighted residuals, iterations, converged, message)."""
-    coefficients, width = _shape_table()
-    empty_i, empty_f = np.empty(0, np.int64), np.empty(0)
-    theta, jac, r, iterations, status = _lm_pulse_sum(
-        np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(y, dtype=float),
-        np.ascontiguousarray(weights, dtype=float), np.asarray(theta, dtype=float),
-        coefficients, width, empty_i if prior_index is None else np.asarray(prior_index, np.int64),
-        empty_f if prior_mean is None else np.asarray(prior_mean, float),
-        empty_f if prior_weight is None else np.asarray(prior_weight, float),
-        int(max_iterations), STEP_TOLERANCE, X_MAX)
-    converged = status == 1 and bool(np.all(np.isfinite(theta)))
-    return theta, jac, r, iterations, converged, _LM_MESSAGES.get(status, "converged" if converged else
-                                                                   "the fit left the range of double precision")
-
-
-#: The messages of ``levenberg_marquardt`` for the compiled fit's status codes.
-_LM_MESSAGES = {0: "the iteration limit was reached", -1: "the model does not depend on every parameter here",
-                -2: "the normal equations are singular", -3: "the start's residuals are not finite"}
-
-
-# ---------------------------------------------------------------------------------------------------------
 # From θ to the reported quantities
 
 def derived(theta, velocity, mass, diameter, poisson) -> np.ndarray:
     """The quantities of ``_FIT_NAMES`` (in that order) from θ, through the exact engine."""
     t0, log_peak, log_duration, x = theta
     peak, duration = math.exp(log_peak), math.exp(log_duration)
-    dimless = powerlaw_single(1.0, _STIFFNESS_SCALE, 1.5, max(x, 0.0), 1.0, 1.0)
+    dimless = powerlaw_single(1.0, STIFFNESS_SCALE, 1.5, max(x, 0.0), 1.0, 1.0)
     t_scale = duration / dimless[CONTACT_DURATION]  # t_H
-    f_scale = peak * _STIFFNESS_SCALE / dimless[PEAK_FORCE]  # K δ_H^1.5
+    f_scale = peak * STIFFNESS_SCALE / dimless[PEAK_FORCE]  # K δ_H^1.5
     e = dimless[RESTITUTION]
     if velocity is not None:
         v = velocity
-        m = f_scale * t_scale / (_STIFFNESS_SCALE * v)  # K δ_H^2.5 = 1.25 m V², δ_H = V t_H
+        m = f_scale * t_scale / (STIFFNESS_SCALE * v)  # K δ_H^2.5 = 1.25 m V², δ_H = V t_H
     else:
         m = mass
-        v = f_scale * t_scale / (_STIFFNESS_SCALE * m)
+        v = f_scale * t_scale / (STIFFNESS_SCALE * m)
     delta_h = v * t_scale
     k = f_scale / delta_h ** 1.5
     modulus = (1.0 - poisson ** 2) * 3.0 * k / (4.0 * math.sqrt(diameter / 2.0)) \
@@ -901,7 +423,7 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
 def prepare() -> None:
     """Build the pulse-shape table now (~0.25 s, once per process), so that a stream's first fit does not
     pay for it while a fruit waits for its line."""
-    _shape_table()
+    shape_table()
 
 
 def at_velocity(result: dict, velocity: float) -> dict:

@@ -5,8 +5,8 @@ add and both contacts are the simulator's Hunt–Crossley pulse, so the contact 
 
     F(t) = F_A · H((t − t0_A)/T_A; x_A) + F_B · H((t − t0_B)/T_B; x_B),
 
-with the tabulated shape H of one pulse (``signals.fit``), eight parameters, by the same Levenberg–Marquardt
-compiled for a sum of pulses (``fit.fit_pulse_sum``).
+with the tabulated shape H of one pulse (``signals.pulse``), eight parameters, by the same Levenberg–Marquardt
+compiled for a sum of pulses (``leastsquares.fit_pulse_sum``).
 
 Starts.  Two pulses a few milliseconds apart show no dip: the second lands on the first one's rise or peak and
 only a shoulder shows.  So the fit is started from several places (``_starts``): the two maxima and the dip
@@ -37,7 +37,9 @@ import math
 import numpy as np
 
 from fruitimpact.engine.powerlaw import restitution_of_x
-from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, X_MAX, PulseModel, fit_pulse_sum, named_result
+from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, named_result
+from fruitimpact.signals.leastsquares import fit_pulse_sum
+from fruitimpact.signals.pulse import X_MAX, PulseModel
 from fruitimpact.signals.indices import SECOND_PULSE_SMOOTHING, departure_from_one_peak
 
 __all__ = ["MISFIT_LIMIT", "split_contact"]
@@ -165,7 +167,7 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
 
 class _Prior:
     """Gaussian priors on one pulse's (ln F_max, ln T, x): extra rows (θ[index] − mean) · weight of the least
-    squares (``fit.fit_pulse_sum``)."""
+    squares (``leastsquares.fit_pulse_sum``)."""
 
     KEYS = ("log_peak", "log_duration", "x")
 
