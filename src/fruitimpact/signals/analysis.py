@@ -65,10 +65,10 @@ SPLIT_GAIN = 0.2
 #: At most this many earlier contacts whose rebound is due guide a joint fit (the latest first; their hypotheses
 #: share the ``split.FITS`` fits; on a line of 10 fruit/s with two rebounds each, 1–3 are due at once).
 MAX_DUE = 3
-#: Largest relative standard error of a split piece's peak force (from the samples alone, the joint covariance):
-#: beyond it the pieces are not told apart and the contact is one overlap.  Over the line scenarios of
-#: tests/linegen.py, 84 % of pieces are within 3 % (median 0.5 %), with errors of their size (p95 1.9 %); the
-#: others had errors of 5–55 %.
+#: Largest relative standard error of the peak force of a split piece that is no rebound (the joint fit's, with
+#: the expected rebound's priors): beyond it the pieces are not told apart and the contact is one overlap.  Over
+#: the pieces kept on the line scenarios of tests/linegen.py it is 0.4 % at the median, 2.1 % at p95, and their
+#: errors are of that size (0.4 %, 2.2 %); two fruit 1.5 ms apart with no rebound due are fixed only to ±5–6 %.
 PIECE_PRECISION = 0.03
 #: Marks a piece of a split in which a third pulse was found but not told apart (``_split_further``).
 HOLDS_TWO = "_holds_two"
@@ -195,18 +195,22 @@ class LineAnalyzer:
             parts = self._split(own, due, FITS, dip=second > OVERLAP_FRACTION * peak)
         elif status == "ok" and due and shape is not None and shape.get("converged") and _may_split(shape, own):
             parts = self._split(own, due, FITS_DUE, dip=False)
-            if parts is not None and _split_gain(shape, parts, own) < SPLIT_GAIN:
+            gain = _split_gain(shape, parts, own) if parts is not None else 0.0
+            if gain < SPLIT_GAIN:
                 parts = None  # one pulse fits as well: one fruit
-            elif parts is not None and not self._holds_a_rebound(parts, impact.noise):
+            elif not any(self._rebounds(parts, impact.noise)):
                 # two pulses, but neither is the rebound that was due: landing within a fraction of a
                 # millisecond, their onsets and amplitudes trade off; one contact, no firmness, is the honest report
-                message = (f"two pulses in one contact ({_split_gain(shape, parts, own):.2f} noise variances per "
-                           f"sample better fitted as two) that could not be told apart: a fruit and the rebound of "
-                           f"#{due[0].sequence} landing together; no firmness")
+                message = (f"two pulses in one contact ({gain:.2f} noise variances per sample better fitted as two) "
+                           f"that could not be told apart: a fruit and the rebound of #{due[0].sequence} landing "
+                           f"together; no firmness")
                 status, parts = "overlap", None
         if parts is not None:
-            parts = self._split_further(parts, due)
-            vague = _imprecise(parts, self._rebounds(parts, impact.noise))
+            flags = self._rebounds(parts, impact.noise)
+            further = self._split_further(parts, flags, due)
+            if further is not parts:
+                parts, flags = further, self._rebounds(further, impact.noise)
+            vague = _imprecise(parts, flags)
             if vague is not None:  # two pulses whose amplitudes the samples do not fix: no firmness either
                 status, parts = "overlap", None
                 message = (f"two pulses in one contact that could not be told apart: a piece's peak force is "
@@ -235,16 +239,17 @@ class LineAnalyzer:
                           impulse=float(np.sum(inside)) / analysis.rate)
         return [self._contact(own, report, shape, status, message)]
 
-    def _split_further(self, parts, due: list[PulseSummary]):
+    def _split_further(self, parts, rebounds: list[bool], due: list[PulseSummary]):
         """The pieces of a split, one of them split again where it holds a third pulse: when more than one earlier
         contact's rebound is due (a fruit and two rebounds landing together), a piece that is no rebound itself
         (its samples less the other piece's pulse), that two pulses fit better by ``SPLIT_GAIN`` and that holds a
         rebound becomes two; one that two pulses fit better but holds none is marked ``HOLDS_TWO`` (reported as
-        an overlap: never one fruit fitted through two)."""
+        an overlap: never one fruit fitted through two).  ``rebounds``: which pieces are rebounds (``_rebounds``).
+        Returns ``parts`` itself when nothing changed."""
         if len(due) < 2 or not _may_split(parts[0][1], parts[0][0]):  # the joint fit left only the noise
             return parts
-        for k, (piece, fit) in enumerate(parts):
-            if self._holds_a_rebound([(piece, fit)], piece.noise):
+        for k, ((piece, fit), rebound) in enumerate(zip(parts, rebounds)):
+            if rebound:
                 continue  # a rebound of its own: the third pulse is in the other piece
             again = self._split(piece, due, FITS_AGAIN, dip=False)
             if again is None or _split_gain(fit, again, piece) < SPLIT_GAIN:
@@ -255,16 +260,12 @@ class LineAnalyzer:
             return sorted([*parts[:k], *again, *parts[k + 1:]], key=lambda part: part[1]["start_time"])
         return parts
 
-    def _holds_a_rebound(self, parts, noise: float) -> bool:
-        """Whether one of the pieces of a split is judged the rebound of an earlier contact (``_rebounds``)."""
-        return any(self._rebounds(parts, noise))
-
     def _rebounds(self, parts, noise: float) -> list[bool]:
         """Which pieces of a split are judged rebounds of earlier contacts of their lane, as ``_contact`` will
         judge them: ``rebounds.judge`` on each piece's own indices and fit, in time order, with the feed prior and
         the last fruit's onset (an earlier piece judged a fruit is the last fruit for the next)."""
         lane = parts[0][0].lane
-        history, last_fruit = self.history_of(lane), self._last_fruit.get(lane)
+        history, last_fruit = self._history.get(lane, []), self._last_fruit.get(lane)
         flags = []
         for piece, fit in parts:
             summary = from_indices(impact_indices(piece, self.analysis.rate), -1, noise, None)
@@ -275,10 +276,6 @@ class LineAnalyzer:
                 last_fruit = summary.onset
             flags.append(rebound)
         return flags
-
-    def history_of(self, lane: int) -> list[PulseSummary]:
-        """The recent contacts of a lane that a later one could be the rebound of."""
-        return self._history.get(lane, [])
 
     def _split(self, own: DetectedImpact, due: list[PulseSummary], fits: int = FITS, dip: bool = True):
         """Two (piece, fit) of a contact holding two pulses, or None (``signals.split``); ``due``: the earlier
