@@ -132,10 +132,8 @@ def cmd_line(args) -> int:
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
     check_outputs(("--plot", args.plot, FIGURE_FORMATS))
-    given = {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
-             if getattr(args, quantity.name, None) is not None}
     report = _library_call(audit_line, points, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
-                           alternatives=args.alternatives, **given)
+                           alternatives=args.alternatives, **lot_inputs(args))
     criterion = report["criterion"]
     spread_lines = report["spreads"]
     _print_warnings("line", report["warnings"])
@@ -206,11 +204,32 @@ def cmd_surfaces(args) -> int:
     return status
 
 
-def add_parsers(sub) -> None:
-    from fruitimpact.handling.drops import BOUNCE_RULES, MAX_IMPACTS
+def add_lot_options(parser) -> None:
+    """The lot of a line audit (``line``, ``sphere``): every input of the table except those each transfer point
+    sets (velocity, drop height, the surface's), ``-n``, ``--seed`` and ``--no-spreads``."""
     from fruitimpact.handling.heights import AXIS_INPUTS
     from fruitimpact.handling.line import LINE_FRUIT
-    from fruitimpact.impact.quantities import INPUTS as TABLE
+
+    group = parser.add_argument_group("population (numbers, or normal(m,sd), lognormal(m,cv), uniform(a,b), ...)")
+    for quantity in INPUTS.values():
+        # each transfer point sets its height and its surface: those inputs are not options of a line
+        if quantity.option and quantity.name not in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):
+            group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
+                               help=quantity.doc)
+    group.add_argument("-n", "--rows", default=str(LINE_FRUIT), metavar="N",
+                       help=f"fruit in the population (default {LINE_FRUIT})")
+    group.add_argument("--seed", default="0", metavar="S", help="random seed, an integer from 0 to 2^128 - 1 (default 0)")
+    add_spread_option(group)
+
+
+def lot_inputs(args) -> dict:
+    """The lot's inputs given on the command line, by name (as typed: the library reads the units)."""
+    return {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
+            if getattr(args, quantity.name, None) is not None}
+
+
+def add_parsers(sub) -> None:
+    from fruitimpact.handling.drops import BOUNCE_RULES, MAX_IMPACTS
 
     dr = sub.add_parser("drop", help="drop a fruit from a height: the rebounds until it rests, damage per impact",
                         description="Drop a fruit from --drop-height onto a surface; every impact at its own "
@@ -241,16 +260,7 @@ def add_parsers(sub) -> None:
                         description="Pass a population of fruit through the transfer points of LINE "
                                     "(CSV: name,drop_height,surface[,fruit_on_fruit]).")
     ln.add_argument("line", metavar="LINE", help="the line's transfer points, CSV")
-    group = ln.add_argument_group("population (numbers, or normal(m,sd), lognormal(m,cv), uniform(a,b), ...)")
-    for quantity in TABLE.values():
-        # each transfer point sets its height and its surface: those inputs are not options of a line
-        if quantity.option and quantity.name not in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):
-            group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
-                               help=quantity.doc)
-    group.add_argument("-n", "--rows", default=str(LINE_FRUIT), metavar="N",
-                       help=f"fruit in the population (default {LINE_FRUIT})")
-    group.add_argument("--seed", default="0", metavar="S", help="random seed, an integer from 0 to 2^128 - 1 (default 0)")
-    add_spread_option(group)
+    add_lot_options(ln)
     ln.add_argument("--alternatives", default="foam-pad", metavar="SURFACES",
                     help="library surfaces tried in place of each transfer point's, to say what each change would "
                          "save (comma-separated; default foam-pad; none to skip)")

@@ -30,12 +30,18 @@ MAX_POINTS = 200
 
 @dataclass(frozen=True)
 class TransferPoint:
-    """One transfer point: where the fruit drops ``drop_height`` [m] onto ``surface``."""
+    """One transfer point: where the fruit drops ``drop_height`` [m] onto ``surface``.
+
+    ``surface_modulus`` [Pa] and ``surface_poisson`` [-], when given, are a measured half-space in place of the
+    library surface's own values (an instrumented sphere's reading, ``spheres``); ``surface`` then names the
+    library surface nearest to it, for the report."""
 
     name: str
     drop_height: float
     surface: str
     fruit_on_fruit: bool = False
+    surface_modulus: float | None = None
+    surface_poisson: float | None = None
 
 
 def _points(line) -> list[TransferPoint]:
@@ -134,6 +140,13 @@ def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
                          f"got {point.surface!r} (fruit on fruit: set fruit_on_fruit to true)")
     if not isinstance(point.fruit_on_fruit, bool):
         raise ValueError(f"{where}: fruit_on_fruit must be True or False; got {point.fruit_on_fruit!r}")
+    if (point.surface_modulus is None) != (point.surface_poisson is None):
+        raise ValueError(f"{where}: a measured surface needs both surface_modulus and surface_poisson")
+    if point.surface_modulus is not None and not (
+            isinstance(point.surface_modulus, float) and point.surface_modulus > 0.0
+            and isinstance(point.surface_poisson, float) and -1.0 < point.surface_poisson < 0.5):
+        raise ValueError(f"{where}: surface_modulus must be > 0 Pa and surface_poisson in (-1, 0.5); got "
+                         f"{point.surface_modulus!r}, {point.surface_poisson!r}")
     return point
 
 
@@ -156,7 +169,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``alternatives``: library surfaces tried in place of each point's own (not at fruit-on-fruit points):
     ``changes`` lists, best first, each (point, surface) with the line's incidence and mean bruise volume
     with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
-    difference)."""
+    difference); ``point_incidence`` is the point's own incidence with the change."""
     from fruitimpact.impact.validation import InputError
     from fruitimpact.library.catalogue import surfaces
     from fruitimpact.physics.constants import STANDARD_GRAVITY
@@ -182,10 +195,14 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     def run(point, surface):
         table = {**members, **constants, "drop_height": np.full(rows, point.drop_height),
                  "surface": surface, "criterion": criterion}
+        if surface is None:  # the point's measured half-space
+            table.update(surface="rigid", surface_modulus=point.surface_modulus,
+                         surface_poisson=point.surface_poisson)
         return evaluation(table)
 
     for point in points:
-        result = run(point, "fruit" if point.fruit_on_fruit else point.surface)
+        result = run(point, "fruit" if point.fruit_on_fruit else
+                     None if point.surface_modulus is not None else point.surface)
         status = result.status
         ok = status == 0
         if not ok.any() and (status == 3).all():
@@ -243,7 +260,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             if j != k:
                 others_volume += v  # summed, not subtracted: a point's unknown (NaN) volume stays its own
         for surface in alternatives:
-            if surface == point.surface:
+            if surface == point.surface and point.surface_modulus is None:
                 continue
             result = run(point, surface)
             ok = (result.status == 0) & valid_so_far
@@ -256,6 +273,7 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             base = float(bruised_any[ok].mean())
             base_volume = float(volume_total[ok].mean())
             changes.append({"point": point.name, "from": point.surface, "to": surface, "incidence": changed,
+                            "point_incidence": float(bruised[ok].mean()),
                             "incidence_saved": base - changed, "mean_bruise_volume": changed_volume,
                             "bruise_volume_saved": base_volume - changed_volume, "fruit": int(ok.sum())})
     changes.sort(key=lambda c: (-c["incidence_saved"], -c["bruise_volume_saved"]))

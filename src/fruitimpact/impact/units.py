@@ -45,6 +45,12 @@ _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf(?
                      re.IGNORECASE)
 
 
+def number_and_unit(text: str) -> tuple[float, str] | None:
+    """``"12ms"`` → (12.0, "ms"), ``"3"`` → (3.0, ""); None when the text does not start with a number."""
+    match = _NUMBER.match(str(text))
+    return None if match is None else (float(match.group(1)), match.group(2))
+
+
 def parse_quantity(text: str | float, dimension: str) -> float:
     """Parse ``text`` (``"115g"``, ``"3 MPa"``, ``"0.065"``) to a float in SI.
 

@@ -99,10 +99,19 @@ def check_value(name: str, value) -> float:
     return number
 
 
+def choice_message(name: str, value, registry) -> str:
+    """The refusal of ``value`` for text input ``name``: the registry's own reason where it has one (a fruit file
+    that cannot be read, ``library.catalogue.FruitRegistry.refusal``), else the names it holds."""
+    explain = getattr(registry, "refusal", None)
+    reason = explain(value) if callable(explain) else None
+    return reason or f"{name} must be one of {', '.join(registry)}; got {value!r}"
+
+
 def check_choice(name: str, value, registry) -> str:
-    """A text input (``model`` …) that must be a key of ``registry``."""
+    """A text input (``model`` …) that must be a key of ``registry`` (for ``fruit``: a library name or a fruit
+    file)."""
     if not isinstance(value, str) or value not in registry:
-        raise InputError(f"{name} must be one of {', '.join(registry)}; got {value!r}", name)
+        raise InputError(choice_message(name, value, registry), name)
     return value
 
 
@@ -327,10 +336,17 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "scheduler": "--scheduler", "engine": "--engine", "workdir": "--workdir",
                      "output": "-o/--output", "input": "IN", "characteristics": "--characteristics",
                      "threshold": "--threshold", "percentiles": "--percentiles", "sample_size": "--sample-size",
-                     "rate": "--rate", "file": "FILE"}  # file: analyze's recording (the web app's upload)
+                     "rate": "--rate", "file": "FILE",  # file: analyze's recording (the web app's upload)
+                     # sphere's own (its log, the sphere, how readings are grouped and judged)
+                     "log": "LOG", "sphere": "--sphere", "sphere_mass": "--sphere-mass",
+                     "sphere_diameter": "--sphere-diameter", "sphere_modulus": "--sphere-modulus",
+                     "sphere_poisson": "--sphere-poisson", "sphere_calibration": "--sphere-calibration",
+                     "sphere_restitution": "--sphere-restitution", "columns": "--columns", "points": "--points",
+                     "point_gap": "--point-gap", "pass_gap": "--pass-gap", "uncertainty": "--uncertainty",
+                     "logger_rate": "--logger-rate", "target": "--target", "spreads": "--no-spreads"}
 
 
-__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag",
+__all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag", "choice_message",
            "check_input_name", "spec_text", "check_value", "conflict_message",
            "implausible_message", "nan_message", "range_message", "read_count", "read_value",
            "unreadable_message", "COMMAND_ARGUMENTS", "usage_message", "is_boolean"]
