@@ -40,7 +40,7 @@ def cmd_sphere(args) -> int:
     check_outputs(("--plot", args.plot, FIGURE_FORMATS))
     options = {dest: getattr(args, dest) for dest, *_ in SPHERE_OPTIONS if getattr(args, dest) is not None}
     report = _library_call(sphere_audit, args.log, sphere=args.sphere, rows=args.rows, seed=args.seed,
-                           spreads=not args.no_spreads, **options, **lot_inputs(args))
+                           spreads=not args.no_spreads, chart=bool(args.plot), **options, **lot_inputs(args))
     for line in skipped_lines(args.log, report["skipped"]):
         print(f"{PROG} sphere: {line}", file=sys.stderr)
     for warning in report["warnings"]:

@@ -54,7 +54,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                  sphere_poisson=None, sphere_calibration=None, sphere_restitution=None, surface_poisson=0.3,
                  columns=None, points=None, point_gap=None, pass_gap=None, uncertainty=None, logger_rate=None,
                  target=TARGET, rows=None, seed: int = 0, criterion: str | None = None, spreads: bool = True,
-                 **inputs) -> dict:
+                 chart: bool = False, **inputs) -> dict:
     """Audit a handling line from an instrumented sphere's log: equivalent drops, surfaces and the lot's bruises.
 
     Parameters
@@ -88,6 +88,9 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         The logger's sample rate [Hz]: logged durations are rounded to its period.
     target : float or str
         Incidence above which a point gets cushion advice (``"5%"``).
+    chart : bool
+        Also compute the chart's incidence lines (``spheres.chart``: the readings at which 10 % and 50 % of the
+        lot bruise, surface by surface), returned as ``chart``.
     rows, seed, criterion, spreads, **inputs
         The lot, as :func:`fruitimpact.audit_line` takes it (``fruit``, ``mass`` …; not ``velocity``,
         ``drop_height`` or the surface, which each point sets).
@@ -137,6 +140,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
 
     # every argument answered before any work
     spreads = check_flag("spreads", spreads)
+    chart = check_flag("chart", chart)
     rows = read_count("rows", LINE_FRUIT if rows is None else rows, 1, MAX_LINE_FRUIT)
     seed = read_count("seed", seed, 0, MAX_SEED)
     mass = quantity("sphere_mass", sphere_mass, "mass")
@@ -292,6 +296,12 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                         **{key: row[key] for key in ("velocity_low", "velocity_high", "drop_height_low",
                                                      "drop_height_high", "restitution_low", "restitution_high",
                                                      "surface_modulus_low", "surface_modulus_high")}})
+    lines = None
+    if chart:
+        from fruitimpact.spheres.chart import incidence_lines
+
+        lines = incidence_lines(body, float(np.median(result.restitution[ok])), nu, rows=rows, seed=seed,
+                                criterion=criterion, spreads=spreads, inputs=inputs)
     worst = report["worst_point"]
     status, message = "ok", ""
     if any(entry["incidence"] is None for entry in point_rows):
@@ -303,7 +313,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         "sphere": {"name": body.name, "mass": body.mass, "diameter": body.diameter,
                    "contact_modulus": body.contact_modulus, "stiffness_source": body.stiffness_source},
         "calibration": calibration, "grouping": groups.method, "uncertainty": error, "target": target,
-        "impacts": impacts, "points": point_rows, "worst_point": worst,
+        "impacts": impacts, "points": point_rows, "worst_point": worst, "chart": lines,
         "incidence": report["incidence"], "mean_bruise_volume": report["mean_bruise_volume"],
         "criterion": report["criterion"], "rows": report["rows"], "seed": report.get("seed", seed),
         "spreads": report.get("spreads"), "inputs": report.get("inputs"),
