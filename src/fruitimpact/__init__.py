@@ -3,7 +3,8 @@
 Topic packages (docs/architecture.md): ``engine`` (compiled solvers), ``physics`` (Hertz contact, damping
 laws), ``damage`` (bruise criteria), ``library`` (fruits and surfaces), ``impact`` (quantities, validation,
 evaluate and simulate), ``handling`` (drops, safe heights, line audits), ``signals`` (force recordings),
-``plotting``, ``reference`` (the founding paper), ``runs`` (large runs) and ``cli``.  SI units throughout.
+``plotting``, ``reference`` (the founding paper), ``runs`` (large runs), ``spheres`` (instrumented-sphere
+logs) and ``cli``.  SI units throughout.
 
 The names below are imported on first use, so that ``import fruitimpact.cli``
 (and ``fruitimpact --help``) does not compile the engine.
@@ -26,6 +27,8 @@ _EXPORTS = {
     "drop": "handling.drops",                                   # fruitimpact drop
     "safe_height": "handling.heights", "risk_map": "handling.heights",  # fruitimpact safe-height [--map]
     "audit_line": "handling.line", "read_line": "handling.line",        # fruitimpact line
+    "sphere_audit": "spheres.audit",                            # fruitimpact sphere
+    "fit_damage": "handling.droptests",
     "analyze": "signals.offline",                               # fruitimpact analyze
     "read_recording": "signals.read", "open_recording": "signals.read", "Recording": "signals.recording",
     "fit_impact": "signals.fit",
