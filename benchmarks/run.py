@@ -3,8 +3,8 @@
     python benchmarks/run.py [--quick] [--markdown FILE]
 
 It also runs interactive.py (per-call latency, start-up) and the signal-path benchmarks (signals.py,
-signals_fit.py, scorecard.py, latency.py and
-analyze_memory.py --quick), which print their own tables; the one-hour memory run of analyze_memory.py is a
+signals_fit.py, scorecard.py, latency.py,
+analyze_memory.py --quick and sphere.py), which print their own tables; the one-hour memory run of analyze_memory.py is a
 command of its own (37 min).
 
 Each line compares fruitimpact with the obvious baseline doing the same job:
@@ -339,7 +339,8 @@ def main(argv=None):
                             ("signals_fit.py", []),
                             ("scorecard.py", ["--quick"] if args.quick else []),
                             ("latency.py", ["--quick"] if args.quick else []),
-                            ("analyze_memory.py", ["--quick"])):
+                            ("analyze_memory.py", ["--quick"]),
+                            ("sphere.py", [])):
         print(f"\n=== benchmarks/{script} {' '.join(options)}", flush=True)
         done = subprocess.run([sys.executable, str(here / script), *options])
         if done.returncode not in (0, 1):  # 1: a goal missed, which the script's own table shows

@@ -224,6 +224,9 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         summaries.append({
             "members": members, "landings": landings,
             "drop_height": float(np.median(result.drop_height[landings])),
+            # the landings' own 95 % intervals, their medians: what one pass can say of the point's drop
+            "drop_height_low": float(np.median(result.bounds["drop_height_low"][landings])),
+            "drop_height_high": float(np.median(result.bounds["drop_height_high"][landings])),
             "drop_height_max": float(np.max(result.drop_height[members])),
             "velocity": float(np.median(result.velocity[landings])),
             "restitution": float(np.median(result.restitution[landings])),
@@ -267,6 +270,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
             continue
         line = by_name[name]
         entry.update(drop_height=summary["drop_height"], drop_height_max=summary["drop_height_max"],
+                     drop_height_low=summary["drop_height_low"], drop_height_high=summary["drop_height_high"],
                      velocity=summary["velocity"], restitution=summary["restitution"],
                      surface_modulus=summary["surface_modulus"], rigid=summary["surface_modulus"] is None,
                      surface=summary["surface"], incidence=line["incidence"],
