@@ -298,3 +298,57 @@ def test_bad_rows_are_reported_and_skipped(tmp_path):
     skipped = [line for line in result.stderr.splitlines() if "row skipped" in line]
     assert [re.search(r", row (\d+)", line).group(1) for line in skipped] == ["3", "4", "5"]
     assert "velocity_change" in skipped[0] and "peak_acceleration" in skipped[2]
+
+
+def test_points_found_without_labels(clean, tmp_path):
+    """Without a point column the readings are clustered along the run: the passes (60 s apart) have the same
+    number of visits (4 s apart), so the k-th visit of each pass is point k; the same drops as with labels.  A
+    --points file of time windows groups them too."""
+    from fruitimpact.spheres.audit import sphere_audit
+
+    log = write_log(tmp_path / "unlabelled.csv", labels=False)
+    options = dict(sphere="is-1987", sphere_modulus="37.5MPa", sphere_poisson=0.5, rows=50, fruit="apple")
+    report = sphere_audit(log, **options)
+    assert report["grouping"] == "clustered"
+    assert [p["name"] for p in report["points"]] == [f"point {k}" for k in range(1, len(POINTS) + 1)]
+    assert [p["passes"] for p in report["points"]] == [3] * len(POINTS)
+    assert [p["drop_height"] for p in report["points"]] == [p["drop_height"] for p in clean["points"]]
+    windows = tmp_path / "points.csv"
+    pass_length = 4.0 * len(POINTS) + 60.0
+    windows.write_text("name,start,end\n" + "".join(f"{name},{p * pass_length + 4 * k - 1},{p * pass_length + 4 * k + 1}\n"
+                                                    for p in range(3) for k, (name, *_) in enumerate(POINTS)))
+    report = sphere_audit(log, points=windows, **options)
+    assert report["grouping"] == "windows" and [p["name"] for p in report["points"]] == [p[0] for p in POINTS]
+    assert [p["drop_height"] for p in report["points"]] == [p["drop_height"] for p in clean["points"]]
+
+
+def test_cushion_advice_is_the_thinnest_that_meets_the_target(clean):
+    """For each point above the target, the advised cushion is the thinnest tried that brings the point below it,
+    and the saving per 10,000 is the difference of the two incidences (the same lot, so paired)."""
+    from fruitimpact.library.catalogue import surfaces
+
+    for point in clean["points"]:
+        advice = point["cushion"]
+        if point["incidence"] <= 0.05:
+            assert advice is None
+            continue
+        if advice["surface"] is None:
+            assert "no library cushion" in advice["message"]
+            continue
+        assert advice["incidence"] < 0.05
+        assert advice["saved_per_10000"] == pytest.approx((point["incidence"] - advice["incidence"]) * 10_000, abs=0.1)
+        thinner = [name for name, entry in surfaces().items()
+                   if entry.model == "layer" and entry.thickness.value < surfaces()[advice["surface"]].thickness.value]
+        assert advice["surface"] not in thinner
+
+
+def test_a_pad_of_given_modulus_is_tried(tmp_path):
+    """--pad MODULUS:THICKNESS is tried with the library's cushions; a soft thick pad saves the 25 cm drop onto
+    steel that no library cushion saves (the 12.7 mm foam bottoms out)."""
+    log = write_log(tmp_path / "log.csv", passes=1)
+    report = json.loads(run("sphere", log, *SPHERE_OPTIONS, "--fruit", "apple", "-n", 500, "--pad", "0.2MPa:30mm",
+                            "--json").stdout)
+    advice = next(p for p in report["points"] if p["name"] == "bin")["cushion"]
+    assert advice["surface"] == "pad 0.2 MPa 30 mm" and advice["incidence"] < 0.05
+    bad = run("sphere", log, *SPHERE_OPTIONS, "--fruit", "apple", "--pad", "3MPa", check=False)
+    assert bad.returncode == 2 and bad.stderr.startswith("fruitimpact sphere: error: argument --pad:")

@@ -29,6 +29,8 @@ SPHERE_OPTIONS = (
     ("uncertainty", "--uncertainty", "FRACTION", "relative standard uncertainty of each reading (default 2%)"),
     ("logger_rate", "--logger-rate", "HZ", "the logger's sample rate: logged durations are rounded to its period"),
     ("target", "--target", "FRACTION", "incidence above which a point gets cushion advice (default 5%)"),
+    ("pad", "--pad", "MODULUS:THICKNESS", "a pad of given modulus and thickness tried with the library's cushions "
+                                          "(e.g. 0.3MPa:10mm)"),
 )
 
 

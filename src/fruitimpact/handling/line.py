@@ -150,6 +150,22 @@ def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
     return point
 
 
+@dataclass(frozen=True)
+class Pad:
+    """A cushion of given properties tried as an alternative: a layer of ``modulus`` E [Pa], ``thickness`` h [m] and
+    ``poisson`` ν [-] on a rigid floor (the library layers' Winkler model, k = (1−ν)E/((1+ν)(1−2ν)h));
+    ``name`` labels it in the report."""
+
+    name: str
+    modulus: float
+    thickness: float
+    poisson: float = 0.3
+
+    def inputs(self) -> dict:
+        return {"surface": "rigid", "surface_model": "layer", "surface_modulus": self.modulus,
+                "surface_thickness": self.thickness, "surface_poisson": self.poisson}
+
+
 #: The surface tried in place of each transfer point's by default (``audit``'s ``alternatives``).
 DEFAULT_ALTERNATIVES = ("foam-pad",)
 
@@ -166,7 +182,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     ``criterion`` and ``warnings``.  A point's figures are over the fruit computed there; the
     cumulated ones over the fruit computed at every point so far (a warning counts the others).
 
-    ``alternatives``: library surfaces tried in place of each point's own (not at fruit-on-fruit points):
+    ``alternatives``: library surfaces (or :class:`Pad`) tried in place of each point's own (not at fruit-on-fruit
+    points):
     ``changes`` lists, best first, each (point, surface) with the line's incidence and mean bruise volume
     with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
     difference); ``point_incidence`` is the point's own incidence with the change."""
@@ -174,10 +191,10 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     from fruitimpact.library.catalogue import surfaces
     from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-    if isinstance(alternatives, str) or not all(isinstance(a, str) for a in alternatives):
-        raise InputError("alternatives must be a sequence of library surface names", "alternatives")
+    if isinstance(alternatives, str) or not all(isinstance(a, (str, Pad)) for a in alternatives):
+        raise InputError("alternatives must be a sequence of library surface names (or Pad)", "alternatives")
     cushions = [name for name, entry in surfaces().items() if entry.partner is None]
-    unknown = [a for a in alternatives if a not in cushions]
+    unknown = [a for a in alternatives if isinstance(a, str) and a not in cushions]
     if unknown:
         raise InputError(f"alternatives must be library surfaces ({', '.join(cushions)}); got {unknown[0]!r}",
                          "alternatives")
@@ -198,6 +215,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         if surface is None:  # the point's measured half-space
             table.update(surface="rigid", surface_modulus=point.surface_modulus,
                          surface_poisson=point.surface_poisson)
+        elif isinstance(surface, Pad):
+            table.update(surface.inputs())
         return evaluation(table)
 
     for point in points:
@@ -272,7 +291,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
             changed_volume = float((others_volume + volume)[ok].mean())
             base = float(bruised_any[ok].mean())
             base_volume = float(volume_total[ok].mean())
-            changes.append({"point": point.name, "from": point.surface, "to": surface, "incidence": changed,
+            changes.append({"point": point.name, "from": point.surface,
+                            "to": surface.name if isinstance(surface, Pad) else surface, "incidence": changed,
                             "point_incidence": float(bruised[ok].mean()),
                             "incidence_saved": base - changed, "mean_bruise_volume": changed_volume,
                             "bruise_volume_saved": base_volume - changed_volume, "fruit": int(ok.sum())})
@@ -296,8 +316,8 @@ def _or_zero(value: float) -> float:
     return 0.0 if math.isnan(value) else value
 
 
-__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS", "TransferPoint", "audit",
-           "audit_line", "read_line"]
+__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS", "Pad", "TransferPoint",
+           "audit", "audit_line", "read_line"]
 
 
 #: Most fruit of one line audit.

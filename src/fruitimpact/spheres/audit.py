@@ -53,7 +53,7 @@ def _nearest_surfaces(sphere, velocity, restitution, peak) -> list[str]:
 def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_diameter=None, sphere_modulus=None,
                  sphere_poisson=None, sphere_calibration=None, sphere_restitution=None, surface_poisson=0.3,
                  columns=None, points=None, point_gap=None, pass_gap=None, uncertainty=None, logger_rate=None,
-                 target=TARGET, rows=None, seed: int = 0, criterion: str | None = None, spreads: bool = True,
+                 target=TARGET, pad=None, rows=None, seed: int = 0, criterion: str | None = None, spreads: bool = True,
                  chart: bool = False, **inputs) -> dict:
     """Audit a handling line from an instrumented sphere's log: equivalent drops, surfaces and the lot's bruises.
 
@@ -88,6 +88,9 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         The logger's sample rate [Hz]: logged durations are rounded to its period.
     target : float or str
         Incidence above which a point gets cushion advice (``"5%"``).
+    pad : str, optional
+        A pad of given modulus and thickness tried with the library's cushions, ``"MODULUS:THICKNESS"``
+        (``"0.3MPa:10mm"``; a layer on a rigid floor, Poisson ratio ``surface_poisson``).
     chart : bool
         Also compute the chart's incidence lines (``spheres.chart``: the readings at which 10 % and 50 % of the
         lot bruise, surface by surface), returned as ``chart``.
@@ -118,7 +121,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     simulating the reaction to impact of apples on rigid plane surfaces"; docs/tasks/sphere.md.
     """
     from fruitimpact.handling.heights import AXIS_INPUTS
-    from fruitimpact.handling.line import LINE_FRUIT, MAX_LINE_FRUIT, TransferPoint, audit_line
+    from fruitimpact.handling.line import LINE_FRUIT, MAX_LINE_FRUIT, Pad, TransferPoint, audit_line
     from fruitimpact.impact.lots import MAX_SEED, read_lot
     from fruitimpact.impact.presets import fruit_criterion
     from fruitimpact.impact.units import parse_quantity
@@ -162,6 +165,16 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     if rate is not None:
         check_number("logger_rate", rate, low=10.0, high=1e7, high_inclusive=True)
     target = check_number("target", quantity("target", target, "dimensionless"), low=0.0, high=1.0)
+    extra = []
+    if pad is not None:
+        modulus_text, colon, thickness_text = str(pad).partition(":")
+        if not colon:
+            raise InputError(f"pad must be MODULUS:THICKNESS, e.g. 0.3MPa:10mm; got {pad!r}", "pad")
+        pad_modulus = check_number("pad", quantity("pad", modulus_text.strip(), "modulus"), low=1e3, high=1e11)
+        pad_thickness = check_number("pad", quantity("pad", thickness_text.strip(), "length"), low=1e-4, high=0.5,
+                                     high_inclusive=True)
+        extra.append(Pad(f"pad {pad_modulus / 1e6:.4g} MPa {pad_thickness * 1e3:.4g} mm", pad_modulus, pad_thickness,
+                         nu))
     criterion = fruit_criterion(inputs.get("fruit"), criterion, "a sphere audit")
     read_lot(inputs, rows=1, seed=seed, spreads=spreads, criterion=criterion,
              excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
@@ -252,9 +265,12 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         line_points.append(TransferPoint(name, summary["drop_height"], summary["surface"],
                                          surface_modulus=None if modulus_w is None else float(modulus_w),
                                          surface_poisson=None if modulus_w is None else float(nu)))
-    cushions = sorted((name for name, entry in surfaces().items() if entry.model == "layer"),
-                      key=lambda name: surfaces()[name].thickness.value)
-    report = audit_line(line_points, rows=rows, seed=seed, criterion=criterion, alternatives=cushions,
+    # the cushions tried, thinnest first: the library's layers and the user's pad
+    thickness = {name: entry.thickness.value for name, entry in surfaces().items() if entry.model == "layer"}
+    thickness.update({p.name: p.thickness for p in extra})
+    cushions = sorted(thickness, key=thickness.get)
+    tried = [next((p for p in extra if p.name == name), name) for name in cushions]
+    report = audit_line(line_points, rows=rows, seed=seed, criterion=criterion, alternatives=tried,
                         spreads=spreads, **inputs)
     by_name = {point["name"]: point for point in report["points"]}
     point_rows = []
