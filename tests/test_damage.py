@@ -685,3 +685,25 @@ def test_a_flattened_spot_never_carries_more_than_the_yield_pressure():
     assert all(i["max_pressure"] <= 3.2e5 * (1 + 1e-9) for i in impacts)
     released = impacts[0]["velocity"] ** 2 / 2 * 0.18
     assert report["total_absorbed_energy"] + report["energy_left"] == pytest.approx(released, rel=1e-9)
+
+
+@pytest.mark.parametrize("inputs", [dict(), dict(fruit="apple", surface="steel", criterion="shear"),
+                                    dict(bounces="constant"), dict(model="lankarani-nikravesh", restitution=0.4)])
+def test_bounces_evaluated_together_are_the_bounces_one_by_one(monkeypatch, inputs):
+    """Issue 15 item 4: an elastic drop's later impacts are predicted (e a closed form of c V for the power-law
+    family) and evaluated in one table; each prediction is checked against the rebound the impact before really
+    had.  The result must be the one-by-one drop's to rounding (1e-12: one table row and one single-row table
+    run the same kernel)."""
+    from fruitimpact.handling import drops
+
+    together = drops.drop("40cm", **inputs)
+    monkeypatch.setattr(drops, "_bounces_at_once", lambda *args: None)
+    alone = drops.drop("40cm", **inputs)
+    assert together["impact_count"] == alone["impact_count"] > 3
+    assert together["warnings"] == alone["warnings"] and together["status"] == alone["status"]
+    for a, b in zip(together["impacts"], alone["impacts"]):
+        for key, value in a.items():
+            if isinstance(value, float) and math.isfinite(value):
+                assert value == pytest.approx(b[key], rel=1e-12, abs=1e-300), key
+            else:
+                assert value == b[key] or (value != value and b[key] != b[key]), key

@@ -142,23 +142,24 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     warnings = list(first.warnings.row(0))
     status, message = "ok", "ok"
     time = math.sqrt(2.0 * height / STANDARD_GRAVITY)
-    result = first
+    result, j = first, 0  # the impact's evaluation and its row there
+    batch = None
     flattened = None
     material_factor = float(first.columns["damping_factor"][0])
     if not math.isfinite(material_factor):
         material_factor = 0.0
     while True:
-        columns = {name: (float(result.columns[name][0])) for name in _IMPACT_FIELDS}
-        code = int(result.status[0])
+        columns = {name: (float(result.columns[name][j])) for name in _IMPACT_FIELDS}
+        code = int(result.status[j])
         impact = {"impact": len(impacts) + 1, "time": time, **columns}
         impact["bruised"] = None if math.isnan(columns["bruised"]) else bool(columns["bruised"])
         impacts.append(impact)
         if code != 0:
             status = "failed" if code == 2 else "inaccurate"
-            message = f"impact {len(impacts)}: {result.messages.text(0)}"
+            message = f"impact {len(impacts)}: {result.messages.text(j)}"
             break
-        if result.plastic_block is not None and result.plastic[0] and columns["permanent_deflection"] > 0.0:
-            flattened = float(result.plastic_block[0, -1])  # the spot as this impact left it: R_p
+        if result.plastic_block is not None and result.plastic[j] and columns["permanent_deflection"] > 0.0:
+            flattened = float(result.plastic_block[j, -1])  # the spot as this impact left it: R_p
         rebound = columns["exit_velocity"]
         if rebound * rebound / (2.0 * STANDARD_GRAVITY) < rest_height or len(impacts) >= max_impacts:
             if len(impacts) >= max_impacts and rebound * rebound / (2.0 * STANDARD_GRAVITY) >= rest_height:
@@ -183,13 +184,23 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
                 next_row.pop(name, None)
             stiffness = next_row.get("stiffness", float(first.columns["law_stiffness"][0]))
             next_row["damping"] = material_factor * float(stiffness)
-        read, messages = read_columns({name: [value] for name, value in next_row.items()})
-        result = evaluate_inputs(read, messages, detail=True)
-        if result.status[0] == 3:
-            status, message = "failed", f"impact {len(impacts) + 1}: {messages.text(0)}"
+        if batch is None and flattened is None and len(impacts) == 1:
+            batch = _bounces_at_once(first, next_row, bounces, material_factor, rest_height, max_impacts)
+        if batch is not None and len(impacts) < batch.rows + 1 and \
+                abs(float(batch.columns["velocity"][len(impacts) - 1]) - velocity) <= 1e-9 * velocity:
+            result, j = batch, len(impacts) - 1  # predicted right: this impact was evaluated with the others
+        else:
+            batch = False if batch is not None else batch  # a prediction missed: the rest one by one, as always
+            read, messages = read_columns({name: [value] for name, value in next_row.items()})
+            result, j = evaluate_inputs(read, messages, detail=True), 0
+            if result.status[0] == 3:
+                status, message = "failed", f"impact {len(impacts) + 1}: {messages.text(0)}"
+                break
+        if result.status[j] == 3:
+            status, message = "failed", f"impact {len(impacts) + 1}: {result.messages.text(j)}"
             break
         kinds = {text.split(":")[0] for text in warnings}
-        for text in result.warnings.row(0):  # one warning of each kind (the first impact's figures)
+        for text in result.warnings.row(j):  # one warning of each kind (the first impact's figures)
             if text.split(":")[0] not in kinds and not text.startswith("diameter"):
                 warnings.append(text)
     rest = impacts[-1]["time"] + impacts[-1]["contact_duration"]
@@ -210,6 +221,38 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         (math.nan if any(b and math.isnan(v) for b, v in zip(bruised, volumes)) else float(np.nansum(volumes))),
         "rest_time": rest, "status": status, "message": message, "warnings": warnings,
     }
+
+
+def _bounces_at_once(first, row: dict, bounces: str, factor: float, rest_height: float, max_impacts: int):
+    """The later impacts of an elastic drop evaluated together in one table, or None where they cannot be
+    predicted: their velocities follow from the law's own restitution without the impacts — for the power-law
+    family e is a closed-form function of x = c V (``engine.powerlaw.exact_restitution``), with ``material``
+    bounces c is the first impact's, with ``constant`` ones e is the first impact's.  The drop loop checks each
+    predicted velocity against the rebound the previous impact really had (to 1e-9) and evaluates the rest one
+    by one at the first miss, so this is a shortcut to the same numbers, never a second model.  Only without
+    plastic or crushing contact (a flattened spot changes the next impact) and with every input a number."""
+    from fruitimpact.engine.powerlaw import exact_restitution
+    from fruitimpact.impact.evaluation import evaluate_inputs
+    from fruitimpact.impact.inputs import read_columns
+    from fruitimpact.physics.registry import get_law
+
+    if (first.plastic is not None and first.plastic[0]) or not math.isfinite(float(first.columns["exit_velocity"][0])):
+        return None
+    law = get_law(str(first.columns["model"][0]))
+    if bounces == "material" and (factor <= 0.0 or not law.force_family.first_integral):
+        return None
+    velocities, velocity = [], float(first.columns["exit_velocity"][0])
+    e_first = float(first.columns["restitution"][0])
+    while velocity * velocity / (2.0 * STANDARD_GRAVITY) >= rest_height * 0.999 and len(velocities) < max_impacts:
+        velocities.append(velocity)  # one more predicted than the loop may need: the miss shows at the rest height
+        e = float(exact_restitution(factor * velocity)) if bounces == "material" else e_first
+        velocity *= e
+    if len(velocities) < 2:
+        return None
+    table = {name: [value] * len(velocities) for name, value in row.items() if name != "velocity"}
+    table["velocity"] = velocities
+    read, messages = read_columns(table)
+    return evaluate_inputs(read, messages, detail=True)
 
 
 def _contact_modulus(evaluation) -> float:
