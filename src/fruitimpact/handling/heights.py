@@ -35,10 +35,16 @@ SENSITIVITY_INPUTS = {"pressure": ("modulus", "mass", "failure_stress"),
 
 
 def _margins(table: dict, heights: np.ndarray):
+    """(ln(1 + margin), the evaluation) at ``heights``: ln of the criterion's stress (or energy) over its
+    threshold, whose root is the margin's.  In ln h it is nearly a straight line (an elastic Hertz impact's
+    stresses go as h^(1/5), its energy as h), so the secant steps of ``safe_heights`` converge in a few
+    evaluations where the margin itself, bent, took ten."""
     from fruitimpact.impact.evaluation import evaluation
 
     result = evaluation({**table, "drop_height": heights})
-    return np.asarray(result.columns["bruise_margin"], dtype=float), result
+    margin = np.asarray(result.columns["bruise_margin"], dtype=float)
+    with np.errstate(divide="ignore"):
+        return np.log1p(np.maximum(margin, -1.0)), result
 
 
 def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
@@ -67,12 +73,24 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
             heights[i], messages[i] = math.inf, f"no bruise up to {HIGHEST:g} m"
             active[i] = False
     side = np.zeros(rows, dtype=np.int8)
+    previous = np.full(rows, np.nan)  # the last secant point: two within TOLERANCE end the search there
+    estimate = np.full(rows, np.nan)
     for _ in range(200):
         if not active.any():
             break
         x = np.where(active, high - f_high * (high - low) / (f_high - f_low), 0.5 * (low + high))
+        # regula falsi converges from one side: the far end of the bracket stays where it is, so the bracket's
+        # width does not shrink although the points have converged (36 evaluations on a straight line); two
+        # secant points within TOLERANCE end the search (before the check below, which would send a point that
+        # converged onto the bracket's end to the bisection)
+        settled = active & np.isfinite(x) & (np.abs(x - previous) <= TOLERANCE)
+        estimate[settled] = x[settled]
         bad = ~((x > low) & (x < high))
         x[bad] = 0.5 * (low[bad] + high[bad])
+        active &= ~settled
+        previous = np.where(active & ~bad, x, np.nan)
+        if not active.any():
+            break
         f_x, step = _margins(table, np.exp(x))
         # a row whose evaluation inside the bracket failed has no margin there: it is not a root, and its NaN
         # must not count as "no bruise" (that narrowed the bracket onto a wrong height reported as ok)
@@ -83,6 +101,9 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
                            f"{text if text and text != 'ok' else 'no bruise margin there'}")
             low[i] = high[i] = math.nan
         active &= ~lost
+        hit = active & (f_x == 0.0)  # the root itself: a bracket end at 0 would stall the secant on that end
+        estimate[hit] = x[hit]
+        active &= ~hit
         above = f_x >= 0.0
         # Illinois: halve the retained end's value when the same end is kept twice
         keep_low = active & above
@@ -96,7 +117,7 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
         side = np.where(keep_low, -1, np.where(keep_high, 1, side)).astype(np.int8)
         active &= (high - low) > TOLERANCE
     done = np.isnan(heights) & np.isfinite(low) & np.array([m == "ok" for m in messages])
-    heights[done] = np.exp(0.5 * (low[done] + high[done]))
+    heights[done] = np.exp(np.where(np.isfinite(estimate), estimate, 0.5 * (low + high))[done])
     return heights, messages
 
 
