@@ -27,7 +27,7 @@ import tornado.ioloop
 import tornado.web
 import tornado.websocket
 
-from fruitimpact.app import explorer, line, recording
+from fruitimpact.app import explorer, line, recording, sphere
 from fruitimpact.app.uploads import MAX_UPLOAD, UploadStore
 from fruitimpact.impact.outputs import dump_json
 from fruitimpact.impact.validation import usage_message
@@ -36,7 +36,7 @@ from fruitimpact.impact.validation import usage_message
 #: beyond it tornado closes the connection without reading it.
 MAX_REQUEST = 64 * 1024
 MAX_BODY = 1024 * 1024
-#: Workers of the long computations (line audits, recordings), apart from the quick ones.
+#: Workers of the long computations (line audits, sphere logs, recordings), apart from the quick ones.
 HEAVY_WORKERS = 2
 #: No script, style, font or image from any other origin.
 SECURITY_POLICY = ("default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
@@ -256,7 +256,7 @@ class MonitorSocket(tornado.websocket.WebSocketHandler):
 def make_app(uploads: UploadStore) -> tornado.web.Application:
     """The tornado application: the pages, ``/static/``, the JSON API under ``/api/`` and the uploads (kept in
     ``uploads``; its owner closes it)."""
-    # line audits and recordings take seconds to minutes: their own two workers, so that they queue among
+    # line audits, sphere logs and recordings take seconds to minutes: their own two workers, so that they queue among
     # themselves and never hold up the explorer's and the impact view's answers (asyncio's default pool)
     heavy = concurrent.futures.ThreadPoolExecutor(HEAVY_WORKERS, thread_name_prefix="fruitimpact-heavy")
     routes = [(path, PageHandler, {"page": page}) for path, page in PAGES.items()]
@@ -270,6 +270,8 @@ def make_app(uploads: UploadStore) -> tornado.web.Application:
         (r"/api/explore", ApiHandler, {"compute": explorer.explore}),
         (r"/api/risk", ApiHandler, {"compute": explorer.risk}),
         (r"/api/line", ApiHandler, {"compute": line.audit, "pool": heavy}),
+        (r"/api/sphere", ApiHandler, {"compute": functools.partial(sphere.audit, uploads=uploads), "pool": heavy}),
+        (r"/api/sphere/choices", ApiHandler, {"compute": sphere.choices, "method": "GET"}),
         (r"/static/(.*)", StaticHandler, {"path": _static()}),
     ]
     return tornado.web.Application(routes, compress_response=True, max_body_size=MAX_BODY,

@@ -1,7 +1,9 @@
-// The line audit: the line's table and the lot → /api/line → numbers per point, charts, verdict, what-if, exports.
+// The line audit: the line's table and the lot → /api/line → numbers per point, charts, verdict, what-if, exports;
+// or, in place of the table, an instrumented sphere's log uploaded → /api/sphere → the measured points' numbers.
 "use strict";
 
 const lot = document.getElementById("lot");
+const sphereForm = document.getElementById("sphere");
 const body = document.querySelector("#points tbody");
 const statusLine = document.getElementById("status");
 const whatIfPoint = document.getElementById("what-if-point");
@@ -9,8 +11,12 @@ const whatIfSurface = document.getElementById("what-if-surface");
 const COLORS = {here: "#2b5f9e", sofar: "#a9c1de", volume: "#8a4b9c", volumeSofar: "#d3bddb"};
 const COLUMNS = 11;  // of the line's table
 let choices = null, last = null, timer = null, inFlight = false, pending = false, changedAt = null;
-// What a test or a curious user can read: answers drawn, the last one's latency [ms] (edit → page drawn), the answer.
-window.fruitimpact = {updates: 0, refusals: 0, latency: null, last: null};
+// The sphere's uploads ({upload, file, size}, by the input naming them), its last answer and the upload limit.
+const sphereFiles = {log: null, sphere_calibration: null};
+let lastSphere = null, uploadMax = 200 * 1024 * 1024;
+// What a test or a curious user can read: answers drawn, the last one's latency [ms] (edit → page drawn), the answer
+// (the typed table's: `last`; the sphere log's: `sphere`).
+window.fruitimpact = {updates: 0, sphereUpdates: 0, refusals: 0, latency: null, last: null, sphere: null};
 
 const percent = (share) => share === null || share === undefined ? "–" : `${fmt(share * 100, 3)} %`;
 const mm3 = (volume) => volume === null || volume === undefined ? "–" : `${fmt(volume * 1e9, 4)} mm³`;
@@ -102,16 +108,35 @@ function whatIf() {
 }
 
 // ------------------------------------------------------------------------------------------------ request
-function request() {
-  const out = {points: tableRows(), fruit: lot.elements.fruit.value, criterion: lot.elements.criterion.value,
-    spreads: lot.elements.spreads.checked,
-    alternatives: [...document.querySelectorAll("#alternatives input:checked")].map((box) => box.value)};
+// Where the transfer points come from: "table" (typed) or "sphere" (a sphere's log).
+const mode = () => document.querySelector("input[name=source]:checked").value;
+
+// The lot, as both sources send it.
+function lotRequest() {
+  const out = {fruit: lot.elements.fruit.value, criterion: lot.elements.criterion.value, spreads: lot.elements.spreads.checked};
   for (const name of ["rows", "seed", "mass", "diameter", "modulus", "failure_stress"]) {
     const value = lot.elements[name].value.trim();
     if (value) out[name] = value;
   }
+  return out;
+}
+
+function request() {
+  const out = {points: tableRows(), ...lotRequest(),
+    alternatives: [...document.querySelectorAll("#alternatives input:checked")].map((box) => box.value)};
   const change = whatIf();
   if (change) out.what_if = change;
+  return out;
+}
+
+// The sphere's log: its uploads by their ids, the sphere's fields as typed, and the lot.
+function sphereRequest() {
+  const out = lotRequest();
+  for (const [name, stored] of Object.entries(sphereFiles)) if (stored) out[name] = stored.upload;
+  for (const control of sphereForm.querySelectorAll("input[data-input]:not([type=file]), select[data-input]")) {
+    const value = control.value.trim();
+    if (value) out[control.dataset.input] = value;
+  }
   return out;
 }
 
@@ -125,11 +150,17 @@ function schedule(delay) {
 
 async function send() {
   if (inFlight) { pending = true; return; }
+  const kind = mode();
+  if (kind === "sphere" && !sphereFiles.log) {  // nothing to audit yet
+    changedAt = null;
+    statusLine.textContent = "choose the sphere's log";
+    return;
+  }
   inFlight = true;
   statusLine.textContent = "computing…";
   let status, answer;
   try {
-    [status, answer] = await postJSON("/api/line", request());
+    [status, answer] = kind === "sphere" ? await postJSON("/api/sphere", sphereRequest()) : await postJSON("/api/line", request());
   } catch (error) {
     statusLine.textContent = `the server did not answer (${error})`;
     answer = null;
@@ -137,7 +168,7 @@ async function send() {
     inFlight = false;
   }
   if (pending) { pending = false; send(); return; }  // overtaken by an edit: audit that instead
-  if (!answer || timer !== null) return;  // an edit is about to be audited
+  if (!answer || timer !== null || kind !== mode()) return;  // an edit is about to be audited, or the source changed
   clearErrors();
   if (status !== 200 || answer.refused) {
     window.fruitimpact.refusals += 1;
@@ -145,14 +176,22 @@ async function send() {
     changedAt = null;
     return;
   }
-  last = answer;
-  render(answer);
   const latency = performance.now() - (changedAt ?? performance.now());
   changedAt = null;
-  window.fruitimpact.updates += 1;
   window.fruitimpact.latency = latency;
-  window.fruitimpact.last = answer;
   const report = answer.report;
+  if (kind === "sphere") {
+    lastSphere = answer;
+    renderSphere(answer);
+    window.fruitimpact.sphereUpdates += 1;
+    window.fruitimpact.sphere = answer;
+    statusLine.textContent = `${report.status}: ${report.rows.toLocaleString("en-US")} fruit audited in ${latency.toFixed(0)} ms`;
+    return;
+  }
+  last = answer;
+  render(answer);
+  window.fruitimpact.updates += 1;
+  window.fruitimpact.last = answer;
   statusLine.textContent = `${report.status}: ${report.rows.toLocaleString("en-US")} fruit audited in ${latency.toFixed(0)} ms`;
 }
 
@@ -160,18 +199,21 @@ async function send() {
 function clearErrors() {
   for (const node of document.querySelectorAll(".field-error, tr.error-row")) node.remove();
   for (const node of document.querySelectorAll(".invalid")) node.classList.remove("invalid");
-  for (const id of ["form-error", "points-error"]) document.getElementById(id).hidden = true;
-  for (const id of ["results", "points", "what-if"]) document.getElementById(id).classList.remove("stale");
+  for (const id of ["form-error", "points-error", "sphere-error"]) document.getElementById(id).hidden = true;
+  for (const id of STALE) document.getElementById(id).classList.remove("stale");
 }
 
 function note(message) {
   return make("p", {className: "field-error", textContent: message, role: "alert"});
 }
 
+// What a refusal leaves pale: the last good numbers.
+const STALE = ["results", "points", "what-if", "sphere-results"];
+
 // The CLI's line next to what it is about: a cell of the line (["points", row, column]), a what-if select, a lot
-// control; anything else above the table or under the lot.
+// or sphere control; anything else above the table (under the sphere's fields) or under the lot.
 function showError(message, argument) {
-  for (const id of ["results", "points", "what-if"]) document.getElementById(id).classList.add("stale");
+  for (const id of STALE) document.getElementById(id).classList.add("stale");
   statusLine.textContent = "input refused";
   if (Array.isArray(argument) && argument[0] === "points") {
     const tr = rows()[argument[1]];
@@ -189,7 +231,7 @@ function showError(message, argument) {
     control.closest("label").after(note(message));
     return;
   }
-  const control = typeof argument === "string" ? lot.querySelector(`[data-input="${argument}"]`) : null;
+  const control = typeof argument === "string" ? lot.querySelector(`[data-input="${argument}"]`) || sphereForm.querySelector(`[data-input="${argument}"]`) : null;
   if (control) {
     const closed = control.closest("details:not([open])");
     if (closed) closed.open = true;  // a refusal inside folded controls must be seen
@@ -197,7 +239,7 @@ function showError(message, argument) {
     (control.tagName === "FIELDSET" ? control : control.closest("label") || control).after(note(message));
     return;
   }
-  const box = document.getElementById(argument === "points" ? "points-error" : "form-error");
+  const box = document.getElementById(argument === "points" ? "points-error" : mode() === "sphere" ? "sphere-error" : "form-error");
   box.textContent = message;
   box.hidden = false;
 }
@@ -255,42 +297,50 @@ function lotText(report) {
   return report.fruit_computed === report.rows ? size : `${size}: ${report.fruit_computed.toLocaleString("en-US")} computed at every point`;
 }
 
+// The verdict in `box`: the share of the lot bruised on the line (`lotLabel`: how it was drawn; `interval`: its
+// 95 % interval, or null), the mean bruise volume per fruit and the most harmful point (`worst`: its name, or null,
+// and `detail`). Its figures' ids start with `prefix`.
+function verdict(box, prefix, {lotLabel, incidence, interval, volume, worst, detail}) {
+  box.replaceChildren(
+    item(`bruised on the line (${lotLabel})`, [
+      make("strong", {className: "big", id: `${prefix}verdict-incidence`, textContent: percent(incidence)}),
+      make("small", {className: "interval", textContent: interval ? ` (95 %: ${percent(interval[0])} to ${percent(interval[1])})` : ""})]),
+    item("mean bruise volume per fruit", mm3(volume), `${prefix}verdict-volume`),
+    worst === null ? item("most harmful transfer point", "none found (no fruit computed)", `${prefix}worst-point`)
+      : item("most harmful transfer point", [make("strong", {className: "big worst", id: `${prefix}worst-point`, textContent: worst}),
+        make("small", {className: "interval detail", textContent: detail})]));
+}
+
 function renderVerdict(answer, worst) {
   const report = answer.report;
-  const interval = answer.incidence_interval;
-  const box = document.getElementById("verdict");
-  const parts = [
-    item(`bruised on the line (criterion ${report.criterion}, ${lotText(report)})`, [
-      make("strong", {className: "big", id: "verdict-incidence", textContent: percent(report.incidence)}),
-      make("small", {className: "interval", textContent: interval ? ` (95 %: ${percent(interval[0])} to ${percent(interval[1])})` : ""})]),
-    item("mean bruise volume per fruit", mm3(report.mean_bruise_volume), "verdict-volume"),
-  ];
-  if (worst >= 0) {
-    const point = report.points[worst];
-    const onto = point.fruit_on_fruit ? "onto fruit" : `onto ${point.surface}`;
-    parts.push(item("most harmful transfer point", [make("strong", {className: "big worst", id: "worst-point", textContent: point.name}),
-      make("small", {className: "interval detail", textContent: `${fmt(point.drop_height * 100, 3)} cm ${onto}: ${percent(point.incidence)} bruised there, ${mm3(point.mean_bruise_volume)}`})]));
-  } else {
-    parts.push(item("most harmful transfer point", "none found (no fruit computed)", "worst-point"));
-  }
-  box.replaceChildren(...parts);
+  const point = report.points[worst];
+  const onto = point && (point.fruit_on_fruit ? "onto fruit" : `onto ${point.surface}`);
+  verdict(document.getElementById("verdict"), "", {
+    lotLabel: `criterion ${report.criterion}, ${lotText(report)}`, incidence: report.incidence,
+    interval: answer.incidence_interval, volume: report.mean_bruise_volume, worst: point ? point.name : null,
+    detail: point && `${fmt(point.drop_height * 100, 3)} cm ${onto}: ${percent(point.incidence)} bruised there, ${mm3(point.mean_bruise_volume)}`});
 }
 
 function renderCharts(answer, worst) {
-  const report = answer.report;
-  const names = report.points.map((point) => point.name);
-  const share = (key) => report.points.map((point) => point[key] === null ? NaN : point[key] * 100);
-  const volume = (key) => report.points.map((point) => point[key] === null ? NaN : point[key] * 1e9);
-  Charts.bars(document.getElementById("chart-incidence"), {
+  drawBars(answer.report.points, worst, "chart-incidence", "chart-volume", "mean_bruise_volume");
+}
+
+// The two bar charts of a line's points (in the SVGs `incidenceId` and `volumeId`): the share bruised and the mean
+// bruise volume per fruit (`volumeKey`), at each point and cumulated, the most harmful point (`worst`) shaded.
+function drawBars(points, worst, incidenceId, volumeId, volumeKey) {
+  const names = points.map((point) => point.name);
+  const share = (key) => points.map((point) => point[key] === null ? NaN : point[key] * 100);
+  const volume = (key) => points.map((point) => point[key] === null || point[key] === undefined ? NaN : point[key] * 1e9);
+  Charts.bars(document.getElementById(incidenceId), {
     categories: names, highlight: worst, yLabel: "bruised [%]", xLabel: "transfer points, in the order the fruit meets them", yMax: 130, tick: (t) => t <= 100 ? String(t) : "",
     format: (v) => `${fmt(v, 3)} %`,
     series: [{values: share("incidence"), color: COLORS.here, label: "at the point"},
              {values: share("cumulative_incidence"), color: COLORS.sofar, label: "so far along the line"}]});
-  const volumes = [...volume("mean_bruise_volume"), ...volume("cumulative_bruise_volume")].filter(Number.isFinite);
-  Charts.bars(document.getElementById("chart-volume"), {
+  const volumes = [...volume(volumeKey), ...volume("cumulative_bruise_volume")].filter(Number.isFinite);
+  Charts.bars(document.getElementById(volumeId), {
     categories: names, highlight: worst, yLabel: "bruise volume [mm³]", xLabel: "transfer points, in the order the fruit meets them", yMax: Math.max(1, ...volumes) * 1.3,
     format: (v) => `${fmt(v, 4)} mm³`,
-    series: [{values: volume("mean_bruise_volume"), color: COLORS.volume, label: "at the point"},
+    series: [{values: volume(volumeKey), color: COLORS.volume, label: "at the point"},
              {values: volume("cumulative_bruise_volume"), color: COLORS.volumeSofar, label: "accumulated"}]});
 }
 
@@ -352,6 +402,107 @@ function renderChanges(answer) {
     : "";
 }
 
+// ------------------------------------------------------------------------------------------- a sphere's log
+// A figure to `digits` significant digits with its unit, the unit small ("–" alone when there is none).
+function withUnit(value, unit, digits = 3) {
+  const text = fmt(value, digits);
+  return text === "–" ? [text] : [text, make("span", {className: "unit", textContent: ` ${unit}`})];
+}
+
+function sphereRow(point, index, worst, target) {
+  const out = (children, title) => make("td", {className: "out", title: title || ""}, children);
+  const cells = [make("td", {className: "index", textContent: index + 1}), make("td", {className: "name", textContent: point.name}),
+    out([String(point.passes)]),
+    out([point.impacts_reproduced === point.impacts ? String(point.impacts) : `${point.impacts_reproduced} of ${point.impacts}`],
+      point.impacts_reproduced === point.impacts ? "" : "the others are reproduced by no impact of the sphere")];
+  if (point.incidence === null) {  // no reading of the point reproduced: its message in place of its figures
+    cells.push(make("td", {className: "message", colSpan: 7, textContent: point.message}));
+    return make("tr", {className: "point failed"}, cells);
+  }
+  const cm = (value) => withUnit(value === null ? null : value * 100, "cm");
+  const interval = make("span", {className: "range", textContent: `${fmt(point.drop_height_low * 100, 3)}–${fmt(point.drop_height_high * 100, 3)}`});
+  const advice = point.cushion;
+  cells.push(
+    make("td", {className: "out drop"}, [...cm(point.drop_height), interval]),
+    out(cm(point.drop_height_max)),
+    make("td", {className: "surface", title: point.message}, [make("b", {}, point.surface_modulus === null ? ["rigid"] : withUnit(point.surface_modulus / 1e6, "MPa")),
+      make("span", {className: "range", textContent: `nearest: ${point.surface}`})]),
+    out(withUnit(point.incidence === null ? null : point.incidence * 100, "%")),
+    out(withUnit(point.bruise_volume === null ? null : point.bruise_volume * 1e9, "mm³", 4)),
+    out(withUnit(point.cumulative_incidence === null ? null : point.cumulative_incidence * 100, "%")),
+    // the cushion, the point's incidence with it and the bruised fruit it saves per 10,000
+    make("td", {className: "cushion", title: advice ? advice.message : ""},
+      !advice ? [make("span", {className: "unit", textContent: `not needed (≤ ${fmt(target * 100, 3)} % target)`})]
+        : advice.surface ? [make("b", {textContent: advice.surface}), ` → ${percent(advice.incidence)}`,
+          make("span", {className: "range saved", textContent: `saves ${fmt(advice.saved_per_10000, 4)} per 10,000`})]
+        : [make("span", {className: "none", textContent: advice.message})]));
+  const tr = make("tr", {className: worst ? "point worst" : "point"}, cells);
+  tr.dataset.name = point.name;
+  return tr;
+}
+
+function renderSphere(answer) {
+  const report = answer.report;
+  document.getElementById("sphere-results").hidden = false;
+  const worst = report.points.findIndex((point) => point.name === answer.worst_point);
+  const point = report.points[worst];
+  const surface = point && (point.surface_modulus === null ? `a rigid surface (${point.surface})` : `${fmt(point.surface_modulus / 1e6, 3)} MPa (nearest ${point.surface})`);
+  verdict(document.getElementById("sphere-verdict"), "sphere-", {
+    lotLabel: `criterion ${report.criterion}, ${report.rows.toLocaleString("en-US")} fruit, seed ${report.seed}`,
+    incidence: report.incidence, interval: null, volume: report.mean_bruise_volume, worst: point ? point.name : null,
+    detail: point && `${fmt(point.drop_height * 100, 3)} cm onto ${surface}: ${percent(point.incidence)} bruised there, ${mm3(point.bruise_volume)}`});
+  document.querySelector("#sphere-points tbody").replaceChildren(...report.points.map((p, i) => sphereRow(p, i, i === worst, report.target)));
+  const reproduced = report.impacts.filter((impact) => impact.status === "ok").length;
+  document.getElementById("sphere-points-note").textContent = `from ${answer.file}: ${report.points.length} transfer points, ${reproduced} of ${report.readings} readings reproduced by an impact`;
+  drawBars(report.points, worst, "sphere-chart-incidence", "sphere-chart-volume", "bruise_volume");
+  const sphere = report.sphere;
+  const lines = [`sphere ${sphere.name}: ${fmt(sphere.mass * 1e3, 4)} g, ${fmt(sphere.diameter * 1e3, 4)} mm, E*_s ${fmt(sphere.contact_modulus / 1e6, 4)} MPa (${sphere.stiffness_source})`,
+    ...(report.calibration ? [`calibration: ${report.calibration.status}: ${report.calibration.message}`] : []),
+    `log ${answer.file}: ${report.readings} readings (${report.kind}), ${reproduced} reproduced by an impact, ${answer.skipped.length} rows skipped; points by ${report.grouping}`];
+  document.getElementById("sphere-lines").replaceChildren(...lines.map((text) => make("li", {textContent: text})));
+  const warnings = [...report.warnings, ...(report.status !== "ok" ? [`${report.status}: ${report.message}`] : [])];
+  document.getElementById("sphere-warnings").replaceChildren(...warnings.map((text) => make("li", {textContent: text})));
+  document.getElementById("sphere-skipped").replaceChildren(...answer.skipped.map((text) => make("li", {textContent: text})));
+  document.getElementById("sphere-command").textContent = answer.command;
+}
+
+// A file chosen for the sphere (`input`: the log's or the calibration's): uploaded, then the log audited.
+async function uploadSphereFile(input) {
+  const name = input.dataset.input;
+  const file = input.files[0];
+  sphereFiles[name] = null;
+  document.getElementById("sphere-calibration-clear").hidden = !(name === "sphere_calibration" ? file : sphereFiles.sphere_calibration);
+  if (!file) { schedule(10); return; }
+  clearErrors();
+  statusLine.textContent = `uploading ${file.name} (${mb(file.size)})…`;
+  const answer = await uploadFile(file, uploadMax);
+  if (answer.refused) {
+    window.fruitimpact.refusals += 1;
+    showError(answer.error, name);  // the upload's refusal, next to the file it is about
+    return;
+  }
+  sphereFiles[name] = answer;
+  schedule(0);
+}
+
+// The transfer points typed in the table, or measured by the sphere: the controls and results of the one chosen.
+function showSource() {
+  const sphere = mode() === "sphere";
+  for (const id of ["table-source", "add-point", "results", "what-if", "alternatives-section"]) document.getElementById(id).hidden = sphere;
+  document.getElementById("sphere").hidden = !sphere;
+  document.getElementById("sphere-results").hidden = !sphere || !lastSphere;  // nothing to show before a log
+  clearErrors();
+  redraw();  // charts drawn while hidden have no width
+  schedule(10);  // the lot may have changed meanwhile
+}
+
+// The charts shown, drawn again to their width.
+function redraw() {
+  const worst = (answer) => answer.report.points.findIndex((point) => point.name === answer.worst_point);
+  if (mode() === "table" && last) renderCharts(last, worst(last));
+  if (mode() === "sphere" && lastSphere) drawBars(lastSphere.report.points, worst(lastSphere), "sphere-chart-incidence", "sphere-chart-volume", "bruise_volume");
+}
+
 // -------------------------------------------------------------------------------------------------- export
 const csvField = (value) => {
   const text = value === null || value === undefined ? "" : String(value);
@@ -359,6 +510,7 @@ const csvField = (value) => {
 };
 
 async function exportAs(kind) {
+  if (kind.startsWith("sphere-")) return exportSphere(kind);
   if (!last) return;
   const charts = ["chart-incidence", "chart-volume"].map((id) => document.getElementById(id));
   if (kind === "svg") for (const svg of charts) download(`${svg.id}.svg`, new Blob([Charts.serialize(svg)], {type: "image/svg+xml"}));
@@ -373,6 +525,25 @@ async function exportAs(kind) {
     const lines = [columns.map(([, header]) => header).join(","),
       ...last.report.points.map((point) => columns.map(([key]) => csvField(point[key])).join(","))];
     download("line-audit.csv", new Blob([lines.join("\n") + "\n"], {type: "text/csv"}));
+  }
+}
+
+function exportSphere(kind) {
+  if (!lastSphere) return;
+  const stem = lastSphere.file.replace(/\.[^.]*$/, "");
+  if (kind === "sphere-json") download(`${stem}-audit.json`, new Blob([JSON.stringify(lastSphere, null, 2)], {type: "application/json"}));
+  if (kind === "sphere-svg") for (const id of ["sphere-chart-incidence", "sphere-chart-volume"]) download(`${stem}-${id.slice(7)}.svg`, new Blob([Charts.serialize(document.getElementById(id))], {type: "image/svg+xml"}));
+  if (kind === "sphere-csv") {
+    const columns = [["name", "name"], ["passes", "passes"], ["impacts", "impacts"], ["impacts_reproduced", "impacts_reproduced"],
+      ["drop_height", "drop_height_m"], ["drop_height_low", "drop_height_low_m"], ["drop_height_high", "drop_height_high_m"],
+      ["drop_height_max", "drop_height_max_m"], ["surface_modulus", "surface_modulus_Pa"], ["surface", "surface"],
+      ["incidence", "incidence"], ["bruise_volume", "bruise_volume_m3"], ["cumulative_incidence", "cumulative_incidence"],
+      ["cumulative_bruise_volume", "cumulative_bruise_volume_m3"], ["status", "status"], ["message", "message"]];
+    const advice = [["surface", "cushion"], ["incidence", "cushion_incidence"], ["saved_per_10000", "cushion_saved_per_10000"]];
+    const lines = [[...columns, ...advice].map(([, header]) => header).join(","),
+      ...lastSphere.report.points.map((point) => [...columns.map(([key]) => csvField(point[key])),
+        ...advice.map(([key]) => csvField(point.cushion ? point.cushion[key] : null))].join(","))];
+    download(`${stem}-points.csv`, new Blob([lines.join("\n") + "\n"], {type: "text/csv"}));
   }
 }
 
@@ -462,7 +633,28 @@ async function start() {
     if (had) schedule(10);
   });
   for (const button of document.querySelectorAll("[data-export]")) button.addEventListener("click", () => exportAs(button.dataset.export));
-  window.addEventListener("resize", () => last && renderCharts(last, last.report.points.findIndex((point) => point.name === last.worst_point)));
+  window.addEventListener("resize", redraw);
+  setUpSphere();
+}
+
+// The sphere's controls: the device profiles, the upload limit, the files and fields, the choice of source.
+async function setUpSphere() {
+  const offered = await (await fetch("/api/sphere/choices")).json();
+  fill(sphereForm.elements.sphere, [{name: "", label: "custom", description: "no profile: its mass and diameter typed below"}, ...offered.devices], "");
+  uploadMax = await uploadLimit("upload-limit");
+  for (const input of sphereForm.querySelectorAll("input[type=file]")) input.addEventListener("change", () => uploadSphereFile(input));
+  document.getElementById("sphere-calibration-clear").addEventListener("click", () => {
+    const input = document.getElementById("sphere-calibration");
+    input.value = "";
+    uploadSphereFile(input);
+  });
+  sphereForm.addEventListener("input", (event) => {
+    if (event.target.type === "file") return;
+    schedule(event.target.tagName === "INPUT" ? 300 : 10);  // typing: wait for a pause
+  });
+  sphereForm.addEventListener("submit", (event) => { event.preventDefault(); schedule(0); });
+  for (const radio of document.querySelectorAll("input[name=source]")) radio.addEventListener("change", showSource);
+  if (mode() !== "table") showSource();  // a choice the browser restored on reload
 }
 
 start();
