@@ -15,12 +15,12 @@ import sys
 
 PROG = "fruitimpact"
 COMMANDS = ("simulate", "paper", "models", "batch", "sweep", "population", "drop", "safe-height", "line", "sphere",
-            "fruits", "surfaces", "analyze", "classes", "stream", "synth", "serve")
+            "fruits", "surfaces", "analyze", "classes", "stream", "synth", "serve", "fit-damage")
 
 
 def build_parser():
     """The argparse parser of every command (built from the table of quantities)."""
-    from fruitimpact.cli import app, damage, reference, runs, signals, simulate, sphere
+    from fruitimpact.cli import app, damage, labtests, reference, runs, signals, simulate, sphere
     from fruitimpact.cli.common import _Parser
 
     parser = _Parser(prog=PROG, description="Simulate and measure fruit impacts on surfaces (SI units).")
@@ -29,6 +29,7 @@ def build_parser():
     reference.add_parsers(sub)
     runs.add_parsers(sub)
     damage.add_parsers(sub)
+    labtests.add_parsers(sub)
     sphere.add_parsers(sub)
     signals.add_parsers(sub)
     app.add_parsers(sub)

@@ -43,8 +43,8 @@ from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_
 from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_forms
 from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from fruitimpact.impact.labels import Labels
-from fruitimpact.impact.validation import (InputError, MessageBook, WarningBook, conflict_message, implausible_message,
-                                           nan_message, range_message)
+from fruitimpact.impact.validation import (InputError, MessageBook, WarningBook, choice_message, conflict_message,
+                                           implausible_message, nan_message, range_message)
 
 #: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is
 #: ``damping``, given or calibrated).
@@ -147,8 +147,7 @@ def _check_text(inputs: InputColumns, messages: MessageBook) -> None:
         labels = inputs.text[name]
         for code, value in enumerate(labels.labels):
             if not (isinstance(value, str) and value in registry):
-                messages.set(labels.codes == code, f"{name} must be one of {', '.join(registry)}; got {value!r}",
-                             name)
+                messages.set(labels.codes == code, choice_message(name, value, registry), name)
 
 
 def _resolve_preset_criterion(inputs: InputColumns, messages: MessageBook) -> None:

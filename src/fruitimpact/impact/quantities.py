@@ -226,8 +226,9 @@ INPUTS: dict[str, Quantity] = _table(
              "accurate (exact) or rk4 (the paper's fixed-step method)",
              default="accurate", option="--method", choices="method"),
     Quantity("fruit", "", "fruit", "text", "", 1.0,
-             "a fruit of the library (fruitimpact fruits): its mass, diameter, modulus, Poisson's ratio and "
-             "damage properties, each overridden by its own option",
+             "a fruit of the library (fruitimpact fruits), or a fruit file (.csv in the library's format, e.g. "
+             "written by fit-damage --output): its mass, diameter, modulus, Poisson's ratio and damage properties, "
+             "each overridden by its own option",
              default="jonathan-apple", option="--fruit", choices="fruit"),
     Quantity("surface", "", "surface", "text", "", 1.0,
              "a surface of the library (fruitimpact surfaces; fruit: an identical free fruit), each property "

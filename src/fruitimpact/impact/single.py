@@ -41,6 +41,7 @@ from fruitimpact.impact.simulation import (Characteristics, ContactLaw, Fruit, I
                                            Surface, _unvalidated)
 from fruitimpact.impact.solvers import SOLVERS
 from fruitimpact.impact.validation import read_value
+from fruitimpact.library.catalogue import is_fruit_file
 from fruitimpact.physics import DAMPING_LAWS
 from fruitimpact.physics.calibrate import damping_factor
 from fruitimpact.physics.constants import STANDARD_GRAVITY
@@ -117,6 +118,8 @@ def _read(fruit, surface, keywords: dict):
     given = {}
     fruit_name, surface_name = INPUTS["fruit"].default, INPUTS["surface"].default
     if isinstance(fruit, str):
+        if is_fruit_file(fruit):
+            return None  # a fruit file may change between calls: the table path reads it (the template is cached)
         fruit_name = fruit
     elif type(fruit) is Fruit:
         for name in ("mass", "diameter", "modulus", "poisson", "stiffness"):

@@ -343,7 +343,9 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "sphere_poisson": "--sphere-poisson", "sphere_calibration": "--sphere-calibration",
                      "sphere_restitution": "--sphere-restitution", "columns": "--columns", "points": "--points",
                      "point_gap": "--point-gap", "pass_gap": "--pass-gap", "uncertainty": "--uncertainty",
-                     "logger_rate": "--logger-rate", "target": "--target", "spreads": "--no-spreads"}
+                     "logger_rate": "--logger-rate", "target": "--target", "pad": "--pad", "spreads": "--no-spreads",
+                     # fit-damage's table of tests and its fitted fruit's name
+                     "tests": "TESTS", "fitted_name": "--name"}
 
 
 __all__ = ["InputError", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag", "choice_message",

@@ -29,14 +29,17 @@ from __future__ import annotations
 
 import csv
 import functools
+import io
 import math
-from collections.abc import Mapping
+import os
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, fields
 from importlib import resources
 from types import MappingProxyType
 
-__all__ = ["ENERGY_BASED", "ENERGY_BASES", "FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit", "LibraryError", "Surface", "Value",
-           "fruit", "fruit_rows", "fruits", "surface", "surface_rows", "surfaces"]
+__all__ = ["ENERGY_BASED", "ENERGY_BASES", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit",
+           "FruitRegistry", "LibraryError", "Surface", "Value", "fruit", "fruit_file_text", "fruit_rows", "fruits",
+           "is_fruit_file", "load_fruit_file", "read_fruit_file", "surface", "surface_rows", "surfaces"]
 
 #: The numeric fields of a fruit and their SI units.
 FRUIT_UNITS = {
@@ -56,6 +59,13 @@ _FRUIT_REQUIRED = ("mass", "diameter", "modulus", "poisson")
 #: Bruise values defined per joule or in joules, and the energies a source can have measured them on.
 ENERGY_BASED = ("bruise_susceptibility", "bruise_threshold_energy")
 ENERGY_BASES = ("impact", "absorbed")
+#: The columns of a fruit row, in the order of ``data/fruits.csv``: the row's texts, then per property X of
+#: ``FRUIT_UNITS`` X, X_low, X_high, X_confirmed, X_source, X_note (and X_basis for ``ENERGY_BASED``).  A fruit
+#: file (``read_fruit_file``) has exactly these.
+FRUIT_COLUMNS = ("name", "description", "modulus_kind", "source", "criterion", "criterion_source", "criterion_note",
+                 *(column for field in FRUIT_UNITS
+                   for column in (field, f"{field}_low", f"{field}_high", f"{field}_confirmed", f"{field}_source",
+                                  f"{field}_note", *((f"{field}_basis",) if field in ENERGY_BASED else ()))))
 _POSITIVE = {"mass", "diameter", "density", "modulus", "failure_stress", "alpha", "bruise_susceptibility",
              "bruise_threshold_energy", "bruise_width_ratio", "thickness", "radius"}
 
@@ -304,9 +314,9 @@ def _value(row: dict[str, str], name: str, unit: str, where: str) -> Value | Non
     return Value(value, low, high, unit, source, confirmed == "true", note, basis)
 
 
-def _common(row: dict[str, str], kind: str, number: int, names: set[str]) -> tuple[str, str]:
+def _common(row: dict[str, str], kind: str, number: int, names: set[str], table: str | None = None) -> tuple[str, str]:
     name = (row.get("name") or "").strip()
-    where = f"{kind}s.csv row {number} ({name or 'no name'})"
+    where = f"{table or kind + 's.csv'} row {number} ({name or 'no name'})"
     if not name or name != name.lower() or " " in name:
         raise LibraryError(f"{where}: a name is lower-case without spaces; got {name!r}")
     if name in names:
@@ -317,29 +327,36 @@ def _common(row: dict[str, str], kind: str, number: int, names: set[str]) -> tup
     return name, where
 
 
+def _fruit(row: dict[str, str], number: int, names: set[str], table: str | None = None) -> Fruit:
+    """The fruit of one row of the library's format, checked (``table``: the file named in messages)."""
+    name, where = _common(row, "fruit", number, names, table)
+    values = {field: _value(row, field, unit, where) for field, unit in FRUIT_UNITS.items()}
+    absent = [field for field in _FRUIT_REQUIRED if values[field] is None]
+    if absent:
+        raise LibraryError(f"{where}: {', '.join(absent)} must be given")
+    modulus_kind = row["modulus_kind"].strip()
+    if not modulus_kind:
+        raise LibraryError(f"{where}: modulus_kind must say which modulus is stored")
+    criterion = (row.get("criterion") or "").strip() or None
+    if criterion is not None and criterion not in ("pressure", "shear", "energy"):
+        raise LibraryError(f"{where}: criterion must be pressure, shear or energy (or empty); got {criterion!r}")
+    if criterion is not None and not (row.get("criterion_source") or "").strip():
+        raise LibraryError(f"{where}: criterion has no source")
+    return Fruit(name=name, description=row["description"].strip(), modulus_kind=modulus_kind,
+                 source=row["source"].strip(), criterion=criterion,
+                 criterion_source=(row.get("criterion_source") or "").strip(),
+                 criterion_note=(row.get("criterion_note") or "").strip(), **values)
+
+
 @functools.cache
-def fruits() -> Mapping[str, Fruit]:
-    """The fruit library, read-only, in file order (read and checked once)."""
+def fruits() -> FruitRegistry:
+    """The fruit library, read-only, in file order (read and checked once); fruit files resolve through it too
+    (:class:`FruitRegistry`)."""
     table, names = {}, set()
     for number, row in enumerate(_read("fruits.csv"), start=1):
-        name, where = _common(row, "fruit", number, names)
-        values = {field: _value(row, field, unit, where) for field, unit in FRUIT_UNITS.items()}
-        absent = [field for field in _FRUIT_REQUIRED if values[field] is None]
-        if absent:
-            raise LibraryError(f"{where}: {', '.join(absent)} must be given")
-        modulus_kind = row["modulus_kind"].strip()
-        if not modulus_kind:
-            raise LibraryError(f"{where}: modulus_kind must say which modulus is stored")
-        criterion = (row.get("criterion") or "").strip() or None
-        if criterion is not None and criterion not in ("pressure", "shear", "energy"):
-            raise LibraryError(f"{where}: criterion must be pressure, shear or energy (or empty); got {criterion!r}")
-        if criterion is not None and not (row.get("criterion_source") or "").strip():
-            raise LibraryError(f"{where}: criterion has no source")
-        table[name] = Fruit(name=name, description=row["description"].strip(), modulus_kind=modulus_kind,
-                            source=row["source"].strip(), criterion=criterion,
-                            criterion_source=(row.get("criterion_source") or "").strip(),
-                            criterion_note=(row.get("criterion_note") or "").strip(), **values)
-    return MappingProxyType(table)
+        entry = _fruit(row, number, names)
+        table[entry.name] = entry
+    return FruitRegistry(table)
 
 
 @functools.cache
@@ -376,12 +393,13 @@ def surfaces() -> Mapping[str, Surface]:
 
 
 def fruit(name: str) -> Fruit:
-    """The library fruit ``name``; ``ValueError`` naming the known fruits otherwise."""
+    """The library fruit ``name``, or the fruit of a fruit file (a path to a ``.csv``, :func:`load_fruit_file`);
+    ``ValueError`` naming the known fruits otherwise."""
     table = fruits()
     try:
         return table[name]
     except (KeyError, TypeError):
-        raise ValueError(f"fruit must be one of {', '.join(table)}; got {name!r}") from None
+        raise ValueError(table.refusal(name) or f"fruit must be one of {', '.join(table)}; got {name!r}") from None
 
 
 def surface(name: str) -> Surface:
@@ -391,6 +409,180 @@ def surface(name: str) -> Surface:
         return table[name]
     except (KeyError, TypeError):
         raise ValueError(f"surface must be one of {', '.join(table)}; got {name!r}") from None
+
+
+# ------------------------------------------------------------------------------------------- fruit files
+
+def is_fruit_file(value) -> bool:
+    """Whether ``value`` names a fruit file rather than a library fruit: a path (text or ``os.PathLike``) ending in
+    ``.csv``.  Whether the file exists is not asked."""
+    return isinstance(value, (str, os.PathLike)) and os.fspath(value).lower().endswith(".csv")
+
+
+def read_fruit_file(path) -> Fruit:
+    """The one fruit of a fruit file: a CSV with the columns of the fruit library (``FRUIT_COLUMNS``, the header
+    of ``data/fruits.csv``; ``#`` comment lines allowed) and one row, checked as the library's rows are (a source
+    for every value, each value inside its range, positive where it must be, …).
+
+    Raises
+    ------
+    LibraryError
+        (a ``ValueError``) naming the file, and the row and column of the first problem: a file that cannot be
+        read, unknown or missing columns, a ragged line, not exactly one fruit, any check of the library's.
+    """
+    shown = os.fspath(path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
+            lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
+    except OSError as exc:
+        raise LibraryError(f"cannot read the fruit file {shown!r}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise LibraryError(f"cannot read the fruit file {shown!r}: not a UTF-8 text file") from None
+    rows = list(csv.reader(lines))
+    if not rows:
+        raise LibraryError(f"fruit file {shown!r} is empty: expected the header of the fruit library (fruits.csv)")
+    header = [cell.strip() for cell in rows[0]]
+    unknown = [cell for cell in header if cell not in FRUIT_COLUMNS]
+    if unknown:
+        raise LibraryError(f"fruit file {shown!r}: unknown column(s) {', '.join(map(repr, unknown))} (a fruit file "
+                           f"has the columns of the fruit library, fruits.csv)")
+    missing = [column for column in FRUIT_COLUMNS if column not in header]
+    if missing:
+        raise LibraryError(f"fruit file {shown!r}: missing column(s) {', '.join(missing)}")
+    if len(rows) != 2:
+        raise LibraryError(f"fruit file {shown!r} holds {len(rows) - 1} rows; a fruit file holds one fruit")
+    if len(rows[1]) != len(header):
+        raise LibraryError(f"fruit file {shown!r}: the fruit's row has {len(rows[1])} fields, the header "
+                           f"{len(header)}")
+    return _fruit(dict(zip(header, rows[1])), 1, set(), f"fruit file {shown!r}")
+
+
+def _cell(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)  # every digit: the file gives back the very numbers written
+    return "" if value is None else str(value)
+
+
+def fruit_file_text(entry: Fruit, comment: str = "") -> str:
+    """``entry`` in the fruit library's own format: ``#`` lines of ``comment``, the header ``FRUIT_COLUMNS`` and
+    one row (floats with every digit), as :func:`read_fruit_file` reads it back."""
+    row = {"name": entry.name, "description": entry.description, "modulus_kind": entry.modulus_kind,
+           "source": entry.source, "criterion": entry.criterion, "criterion_source": entry.criterion_source,
+           "criterion_note": entry.criterion_note}
+    for field in FRUIT_UNITS:
+        value = getattr(entry, field)
+        if value is not None:
+            row.update({field: value.value, f"{field}_low": value.low, f"{field}_high": value.high,
+                        f"{field}_confirmed": value.confirmed, f"{field}_source": value.source,
+                        f"{field}_note": value.note})
+            if field in ENERGY_BASED:
+                row[f"{field}_basis"] = value.basis
+    out = io.StringIO()
+    for line in comment.splitlines():
+        out.write(f"# {line}\n")
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(FRUIT_COLUMNS)
+    writer.writerow([_cell(row.get(column)) for column in FRUIT_COLUMNS])
+    return out.getvalue()
+
+
+#: Fruit files loaded so far: real path → ((inode, size, mtime), fruit), and fruit name → (real path, fruit).
+_FILES: dict = {}
+_NAMED: dict = {}
+
+
+def _numbers(entry: Fruit) -> tuple:
+    """What makes two fruits the same fruit: every value with its range and basis, and the criterion."""
+    return tuple((name, value.value, value.low, value.high, value.basis) for name, value in entry.values().items()) \
+        + (entry.criterion,)
+
+
+def load_fruit_file(path) -> Fruit:
+    """The fruit of the fruit file ``path`` (:func:`read_fruit_file`), registered under its name: ``fruits()[name]``
+    then finds it too.  Read again only when the file changed.  A fruit whose name is a library fruit's, or that of
+    a fruit loaded from another file, is accepted only with the same values (``_numbers``).
+
+    Raises
+    ------
+    LibraryError
+        A file that cannot be read or breaks a rule of the library, or a clash of names, naming the file.
+    """
+    shown = os.fspath(path)
+    real = os.path.realpath(path)
+    try:
+        status = os.stat(real)
+    except OSError as exc:
+        raise LibraryError(f"cannot read the fruit file {shown!r}: {exc.strerror or exc}") from None
+    stamp = (status.st_ino, status.st_size, status.st_mtime_ns)  # atomic writes give a new inode
+    known = _FILES.get(real)
+    if known is not None and known[0] == stamp:
+        return known[1]
+    entry = read_fruit_file(path)
+    library = fruits().library.get(entry.name)
+    if library is not None and _numbers(library) != _numbers(entry):
+        raise LibraryError(f"fruit file {shown!r} names its fruit {entry.name!r}, a fruit of the library with other "
+                           f"values: give the fitted fruit another name")
+    other = _NAMED.get(entry.name)
+    if other is not None and other[0] != real and _numbers(other[1]) != _numbers(entry):
+        raise LibraryError(f"fruit file {shown!r} names its fruit {entry.name!r}, the name of the fruit of "
+                           f"{other[0]!r} with other values: give one of them another name")
+    _FILES[real] = (stamp, entry)
+    _NAMED[entry.name] = (real, entry)
+    return entry
+
+
+class FruitRegistry(Mapping):
+    """The fruit library as a read-only mapping, name → :class:`Fruit`, that also resolves fruit files.
+
+    Iterating gives the library's fruits in file order (what ``fruitimpact fruits`` lists and messages name).
+    Looking up a path to an existing ``.csv`` file loads it (:func:`load_fruit_file`) and registers its fruit under
+    its name, which is then found too; so every ``fruit`` input (``--fruit``, a batch's ``fruit`` column, a Python
+    ``fruit=``) accepts a fruit file wherever it accepts a library name.  A file that breaks a rule is not in the
+    registry; :meth:`refusal` says why."""
+
+    def __init__(self, entries: dict[str, Fruit]):
+        self.library = MappingProxyType(dict(entries))
+
+    def __getitem__(self, key) -> Fruit:
+        if isinstance(key, str):
+            entry = self.library.get(key)
+            if entry is not None:
+                return entry
+            named = _NAMED.get(key)
+            if named is not None:
+                return named[1]
+        if is_fruit_file(key) and os.path.isfile(key):
+            return load_fruit_file(key)
+        raise KeyError(key)
+
+    def __contains__(self, key) -> bool:
+        try:
+            self[key]
+        except (KeyError, TypeError, LibraryError):
+            return False
+        return True
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.library)
+
+    def __len__(self) -> int:
+        return len(self.library)
+
+    def refusal(self, key) -> str | None:
+        """Why ``key`` names no fruit, when it names a fruit file (one line naming ``fruit``); None otherwise (the
+        caller's own "must be one of" message applies)."""
+        if not is_fruit_file(key) or key in self:
+            return None
+        if not os.path.isfile(key):
+            return (f"fruit must be one of {', '.join(self.library)} or a fruit file (.csv); the file "
+                    f"{os.fspath(key)!r} does not exist")
+        try:
+            load_fruit_file(key)
+        except LibraryError as exc:
+            return str(exc)
+        return None
 
 
 # ----------------------------------------------------------------------------------------------- listing
