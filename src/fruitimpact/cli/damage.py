@@ -204,18 +204,24 @@ def cmd_surfaces(args) -> int:
     return status
 
 
-def add_lot_options(parser) -> None:
-    """The lot of a line audit (``line``, ``sphere``): every input of the table except those each transfer point
-    sets (velocity, drop height, the surface's), ``-n``, ``--seed`` and ``--no-spreads``."""
+def _lot_quantities():
+    """The inputs of a lot: every input of the table with an option except those each transfer point sets
+    (velocity, drop height, the surface's)."""
     from fruitimpact.handling.heights import AXIS_INPUTS
+
+    return [quantity for quantity in INPUTS.values()
+            if quantity.option and quantity.name not in ("velocity", "drop_height", *AXIS_INPUTS["surface"])]
+
+
+def add_lot_options(parser) -> None:
+    """The lot of a line audit (``line``, ``sphere``): ``_lot_quantities``, ``-n``, ``--seed`` and
+    ``--no-spreads``."""
     from fruitimpact.handling.line import LINE_FRUIT
 
     group = parser.add_argument_group("population (numbers, or normal(m,sd), lognormal(m,cv), uniform(a,b), ...)")
-    for quantity in INPUTS.values():
-        # each transfer point sets its height and its surface: those inputs are not options of a line
-        if quantity.option and quantity.name not in ("velocity", "drop_height", *AXIS_INPUTS["surface"]):
-            group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
-                               help=quantity.doc)
+    for quantity in _lot_quantities():
+        group.add_argument(quantity.option, dest=quantity.name, metavar="SPEC" if quantity.numeric else "NAME",
+                           help=quantity.doc)
     group.add_argument("-n", "--rows", default=str(LINE_FRUIT), metavar="N",
                        help=f"fruit in the population (default {LINE_FRUIT})")
     group.add_argument("--seed", default="0", metavar="S", help="random seed, an integer from 0 to 2^128 - 1 (default 0)")
@@ -224,7 +230,7 @@ def add_lot_options(parser) -> None:
 
 def lot_inputs(args) -> dict:
     """The lot's inputs given on the command line, by name (as typed: the library reads the units)."""
-    return {quantity.name: getattr(args, quantity.name) for quantity in INPUTS.values()
+    return {quantity.name: getattr(args, quantity.name) for quantity in _lot_quantities()
             if getattr(args, quantity.name, None) is not None}
 
 

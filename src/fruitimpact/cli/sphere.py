@@ -26,9 +26,9 @@ SPHERE_OPTIONS = (
                                    "column"),
     ("point_gap", "--point-gap", "TIME", "readings closer than this are one visit of a point (default 1s)"),
     ("pass_gap", "--pass-gap", "TIME", "a gap longer than this starts a new pass through the line (default 20s)"),
-    ("uncertainty", "--uncertainty", "FRACTION", "relative standard uncertainty of each reading (default 2%)"),
+    ("uncertainty", "--uncertainty", "FRACTION", "relative standard uncertainty of each reading (default 2%%)"),
     ("logger_rate", "--logger-rate", "HZ", "the logger's sample rate: logged durations are rounded to its period"),
-    ("target", "--target", "FRACTION", "incidence above which a point gets cushion advice (default 5%)"),
+    ("target", "--target", "FRACTION", "incidence above which a point gets cushion advice (default 5%%)"),
     ("pad", "--pad", "MODULUS:THICKNESS", "a pad of given modulus and thickness tried with the library's cushions "
                                           "(e.g. 0.3MPa:10mm)"),
 )

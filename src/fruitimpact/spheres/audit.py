@@ -160,7 +160,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     pass_gap = check_number("pass_gap", quantity("pass_gap", pass_gap, "time", PASS_GAP), low=point_gap,
                             low_inclusive=False, high=86400.0, high_inclusive=True)
     error = check_number("uncertainty", quantity("uncertainty", uncertainty, "dimensionless", DEFAULT_UNCERTAINTY),
-                         low=0.0, high=0.5, high_inclusive=True)
+                         low=1e-4, high=0.5, high_inclusive=True)  # a reading is never exact
     rate = quantity("logger_rate", logger_rate, "frequency")
     if rate is not None:
         check_number("logger_rate", rate, low=10.0, high=1e7, high_inclusive=True)
@@ -186,9 +186,12 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
             calibration = read_calibration(sphere_calibration, probe.mass, probe.diameter)
         except ValueError as exc:
             raise InputError(str(exc), "sphere_calibration") from None
+        # the fit's 95 % interval of its mean, as a relative standard uncertainty (one drop: its scatter unknown)
+        half = math.log(calibration["contact_modulus_high"] / calibration["contact_modulus"]) \
+            if math.isfinite(calibration["contact_modulus_high"]) else 0.0
         body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson,
                             calibrated_modulus=calibration["contact_modulus"],
-                            calibration_source=f"calibration {sphere_calibration}")
+                            calibration_source=f"calibration {sphere_calibration}", calibrated_sd=half / 1.96)
     else:
         body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson)
     try:
@@ -209,14 +212,23 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     if windows is not None and readings.point is not None:
         raise InputError("points: the log has a point column; a points file would assign the readings twice", "points")
 
+    ignored = []
+    if restitution is not None and not untimed:
+        ignored.append("--sphere-restitution is not used: every reading has a duration, which gives its own e")
+    if rate is not None and readings.kind == "trace":
+        ignored.append(f"--logger-rate is not used: the trace's own sample period is "
+                       f"{readings.sample_period:.6g} s")
+
     # the work
     period = readings.sample_period or (1.0 / rate if rate else 0.0)
     result = invert(body, readings.peak, readings.change, readings.duration, restitution=restitution,
                     surface_poisson=nu, uncertainty=error, sample_period=period)
     groups = group(readings.time, readings.point, windows, point_gap=point_gap, pass_gap=pass_gap)
-    warnings = list(readings.warnings) + list(groups.warnings)
-    if calibration is not None and calibration["status"] != "ok":
-        warnings.append(f"sphere calibration: {calibration['message']}")
+    warnings = ignored + list(readings.warnings) + list(groups.warnings)
+    if calibration is not None:
+        warnings += [f"sphere calibration: {text}" for text in calibration["warnings"]]
+        if calibration["status"] != "ok":
+            warnings.append(f"sphere calibration: {calibration['message']}")
     ok = result.status == 0
     bad = int(np.count_nonzero(~ok))
     if bad:
@@ -229,8 +241,10 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         if members.size == 0:
             summaries.append(None)
             continue
-        landings = np.array([members[groups.visit[members] == v][np.argmax(result.drop_height[members[
-            groups.visit[members] == v]])] for v in np.unique(groups.visit[members])])
+        # each visit's landing: its largest equivalent drop (sorted by visit, then by drop: the last of each visit)
+        order = members[np.lexsort((result.drop_height[members], groups.visit[members]))]
+        visits = groups.visit[order]
+        landings = order[np.append(visits[1:] != visits[:-1], True)]
         rigid = result.rigid[landings]
         measured = landings[~rigid]
         is_rigid = rigid.sum() * 2 > landings.size
@@ -281,7 +295,8 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         if summary is None:
             entry.update(drop_height=None, drop_height_max=None, surface_modulus=None, surface=None, incidence=None,
                          bruise_volume=None, cumulative_incidence=None, cushion=None, status="failed",
-                         message="no reading of this point is reproduced by an impact of the sphere")
+                         message="no reading of this point is reproduced by an impact of the sphere" if members.size
+                         else "no reading falls in this point's window(s)")
             point_rows.append(entry)
             continue
         line = by_name[name]

@@ -40,8 +40,12 @@ POOR_SCATTER = 0.10
 POOR_DURATION = 0.10
 
 
+#: Calibration drops higher than this [m] are legal but implausible for a sphere meant for handling lines.
+IMPLAUSIBLE_HEIGHT = 3.0
+
+
 def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acceleration, velocity_change,
-              duration=None) -> dict:
+              duration=None, rows=None) -> dict:
     """Fit the sphere's contact modulus E*_s and Hunt–Crossley damping to drops onto a rigid plate.
 
     Parameters
@@ -58,14 +62,16 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
         ΔV [m/s].
     duration : array_like, optional
         T [s] (NaN where not logged).
+    rows : array_like of int, optional
+        The file's row number of each drop, for the messages.
 
     Returns
     -------
     dict
         ``contact_modulus`` E*_s [Pa] with ``_low``/``_high`` (95 % of the mean) and ``contact_modulus_scatter``
         (relative sd of one drop); ``damping_factor`` c [s/m] with its scatter; ``restitution`` (per drop);
-        ``duration_residual`` (rms relative, NaN without durations); ``drops``; ``status`` (``ok``, ``poor``)
-        and ``message``.
+        ``duration_residual`` (rms relative, NaN without durations); ``drops``; ``status`` (``ok``, ``poor``),
+        ``message`` and ``warnings``.
     """
     height = np.atleast_1d(np.asarray(drop_height, dtype=float))
     peak = np.asarray(peak_acceleration, dtype=float)
@@ -75,7 +81,8 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
     bad = np.flatnonzero(~((e > 0.0) & (e <= 1.0 + 0.02)))
     if bad.size:
         i = int(bad[0])
-        raise ValueError(f"sphere_calibration: drop {i + 1} (h = {height[i]:.4g} m) reads ΔV = {change[i]:.4g} m/s, "
+        where = f"row {int(rows[i])}" if rows is not None else f"drop {i + 1}"
+        raise ValueError(f"sphere_calibration: {where} (h = {height[i]:.4g} m) reads ΔV = {change[i]:.4g} m/s, "
                          f"a restitution of {e[i]:.3g} on the plate (ΔV must lie in (V, 2V] = ({velocity[i]:.4g}, "
                          f"{2 * velocity[i]:.4g}] m/s): not a free drop from that height")
     e = np.clip(e, E_MIN, 1.0)  # within 2 % above 1: elastic to the readings' precision
@@ -107,6 +114,11 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
                    f"{scatter:.1%} (limit {POOR_SCATTER:.0%})" + ("" if math.isnan(residual) else
                    f", durations predicted within {residual:.1%} rms (limit {POOR_DURATION:.0%})") +
                    "; surface moduli from this sphere are that uncertain")
+    warnings = []
+    high = int(np.count_nonzero(height > IMPLAUSIBLE_HEIGHT))
+    if high:
+        warnings.append(f"{high} calibration drop(s) from above {IMPLAUSIBLE_HEIGHT:g} m: implausible for a handling "
+                        f"sphere (computed as given)")
     return {"drops": int(n), "contact_modulus": centre,
             "contact_modulus_low": centre * math.exp(-half) if n > 1 else math.nan,
             "contact_modulus_high": centre * math.exp(half) if n > 1 else math.nan,
@@ -115,7 +127,7 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
             "damping_factor_scatter": float(np.std(factor, ddof=1) / np.mean(factor)) if n > 1 and np.mean(factor) > 0
             else math.nan,
             "restitution": [float(v) for v in e], "duration_residual": residual, "status": status,
-            "message": message}
+            "message": message, "warnings": warnings}
 
 
 def read_calibration(path, sphere_mass: float, sphere_diameter: float, columns=None) -> dict:
@@ -126,13 +138,13 @@ def read_calibration(path, sphere_mass: float, sphere_diameter: float, columns=N
 
     mapping = parse_columns(columns, tuple(CALIBRATION_COLUMNS)) if columns else {}
     try:
-        values, _, good, _, skipped = read_table(path, CALIBRATION_COLUMNS, mapping)
+        values, _, good, numbers, skipped = read_table(path, CALIBRATION_COLUMNS, mapping, hint="")
     except ValueError as exc:
         raise ValueError(f"sphere_calibration: {exc}") from None
     if not good.all():
         raise ValueError(f"sphere_calibration: {path}, {_skipped_text(skipped)}")
     report = calibrate(sphere_mass, sphere_diameter, values["drop_height"], values["peak_acceleration"],
-                       values["velocity_change"], values["duration"])
+                       values["velocity_change"], values["duration"], numbers)
     report["file"] = str(path)
     return report
 

@@ -62,6 +62,8 @@ class Sphere:
         The device profile, or ``"custom"``.
     stiffness_source : str
         Where ``contact_modulus`` comes from (the options, or the calibration and its fit).
+    contact_modulus_sd : float
+        Relative standard uncertainty of ``contact_modulus`` [-]: a calibration's (0 for a value given).
     """
 
     mass: float
@@ -69,6 +71,7 @@ class Sphere:
     contact_modulus: float
     name: str = "custom"
     stiffness_source: str = "--sphere-modulus and --sphere-poisson"
+    contact_modulus_sd: float = 0.0
 
     @property
     def radius(self) -> float:
@@ -84,11 +87,12 @@ class Sphere:
 
 
 def build_sphere(*, device: str | None = None, mass=None, diameter=None, modulus=None, poisson=None,
-                 calibrated_modulus: float | None = None, calibration_source: str = "") -> Sphere:
+                 calibrated_modulus: float | None = None, calibration_source: str = "",
+                 calibrated_sd: float = 0.0) -> Sphere:
     """The sphere from a profile and/or explicit values (explicit values win over the profile's).
 
-    ``calibrated_modulus``: E*_s [Pa] fitted by a calibration (then ``modulus``/``poisson`` must not be given:
-    two stiffnesses for one sphere).  ``InputError`` naming the option that is missing or out of range."""
+    ``calibrated_modulus``: E*_s [Pa] fitted by a calibration, with its relative standard uncertainty
+    ``calibrated_sd`` (then ``modulus``/``poisson`` must not be given: two stiffnesses for one sphere).  ``InputError`` naming the option that is missing or out of range."""
     from fruitimpact.impact.validation import InputError, check_number
 
     if device is not None and device not in DEVICES:
@@ -106,7 +110,7 @@ def build_sphere(*, device: str | None = None, mass=None, diameter=None, modulus
         if modulus is not None or poisson is not None:
             raise InputError("sphere_modulus: give either the sphere's modulus (--sphere-modulus, --sphere-poisson) "
                              "or a calibration (--sphere-calibration), not both", "sphere_modulus")
-        return Sphere(mass, diameter, calibrated_modulus, device or "custom", calibration_source)
+        return Sphere(mass, diameter, calibrated_modulus, device or "custom", calibration_source, calibrated_sd)
     if modulus is None or poisson is None:
         missing = "sphere_modulus" if modulus is None else "sphere_poisson"
         raise InputError(f"{missing} is needed: the sphere's stiffness is not published for "

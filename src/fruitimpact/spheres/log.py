@@ -54,8 +54,9 @@ IMPLAUSIBLE_PEAK = 2000.0 * STANDARD_GRAVITY
 IMPLAUSIBLE_CHANGE = 20.0
 #: A trace's sample times may differ from uniform by this share of the period.
 TRACE_JITTER = 0.01
-#: Most rows of one log.
-MAX_ROWS = 50_000_000
+#: Most rows of one log (readings: a survey logs thousands; a raw trace: about 80 min at 10 kHz).  The reader
+#: holds the file's rows in memory (about 1 GB per million rows), so the bound keeps it within a workstation's.
+MAX_ROWS = 5_000_000
 
 
 @dataclass
@@ -129,9 +130,9 @@ def _cell(text: str, dimension: str, factor: float) -> float:
     return value
 
 
-def _table(path, mapping: dict, schema: dict):
+def _table(path, mapping: dict, schema: dict, hint: str = "; map a vendor's headers with --columns name=Header"):
     """(our name of each header cell, unit factors, data rows with their line numbers); ``mapping`` as
-    ``parse_columns`` returns it."""
+    ``parse_columns`` returns it; ``hint`` ends the message of an unknown column."""
     if not isinstance(path, (str, os.PathLike)):
         raise ValueError(f"log must be a path to a CSV file; got {path!r}")
     try:
@@ -157,8 +158,7 @@ def _table(path, mapping: dict, schema: dict):
     for cell in header:
         name = vendor.get(cell, cell if cell in schema and cell not in mapping else None)
         if name is None:
-            raise ValueError(f"{path}: unknown column {cell!r} (columns: {', '.join(schema)}; map a vendor's "
-                             f"headers with --columns name=Header)")
+            raise ValueError(f"{path}: unknown column {cell!r} (columns: {', '.join(schema)}{hint})")
         if name in named:
             raise ValueError(f"{path}: column {name} appears twice")
         named.append(name)
@@ -175,13 +175,14 @@ def _table(path, mapping: dict, schema: dict):
     return named, factors, data
 
 
-def read_table(path, schema: dict, mapping: dict | None = None, label: str = ""):
+def read_table(path, schema: dict, mapping: dict | None = None, label: str = "",
+               hint: str = "; map a vendor's headers with --columns name=Header"):
     """Rows of a CSV with the columns of ``schema`` ({name: (dimension, default unit, required)}), in SI.
 
     Returns (values {name: array, NaN where absent}, labels of a ``point`` column or None, usable (bool per
     row), the file's row numbers, skipped [(row, column, reason)]).  ``ValueError`` for what refuses the whole
     file: unreadable, unknown or missing columns, no rows."""
-    named, factors, data = _table(path, mapping or {}, schema)
+    named, factors, data = _table(path, mapping or {}, schema, hint)
     required = [name for name, (_, _, needed) in schema.items() if needed and name not in named]
     if required:
         raise ValueError(f"{path}: missing column(s) {', '.join(required)}{label}")

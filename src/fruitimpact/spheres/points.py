@@ -86,6 +86,11 @@ def read_windows(path) -> list[tuple[str, float, float]]:
         windows.append((name, start, end))
     if not windows:
         raise ValueError(f"points: {path} has no window below its header")
+    ordered = sorted(windows, key=lambda w: w[1])
+    for (name_a, start_a, end_a), (name_b, start_b, end_b) in zip(ordered, ordered[1:]):
+        if start_b <= end_a:  # a reading in both would belong to one of them by the order of the file
+            raise ValueError(f"points: {path}: the windows of {name_a!r} ({start_a:g}-{end_a:g} s) and {name_b!r} "
+                             f"({start_b:g}-{end_b:g} s) overlap")
     if len({name for name, _, _ in windows}) > MAX_POINTS:
         raise ValueError(f"points: {path} names more than {MAX_POINTS} points")
     return windows
@@ -105,7 +110,7 @@ def group(time, labels=None, windows=None, *, point_gap: float = POINT_GAP, pass
         names = list(dict.fromkeys(name for name, _, _ in windows))
         index = {name: k for k, name in enumerate(names)}
         point = np.full(n, -1, dtype=int)
-        for name, start, end in windows:  # a reading in two windows goes to the first listed
+        for name, start, end in windows:  # windows do not overlap (read_windows)
             inside = (point < 0) & (time >= start) & (time <= end)
             point[inside] = index[name]
         outside = int(np.count_nonzero(point < 0))
