@@ -869,3 +869,26 @@ def test_memory_is_bounded_by_the_chunk_not_the_file(tmp_path, monkeypatch, suff
     assert full > whole, (full, whole)  # the instrument sees a file-sized reading
     assert peaks[1] < 1.2 * peaks[0] + (64 << 10), peaks  # 4x the file, (almost) the same peak
     assert peaks[1] < whole / 4, (peaks, whole)
+
+
+def test_a_tdms_file_cut_short_is_read_with_one_warning(tmp_path):
+    """A TDMS file cut mid-segment (a logger stopped, a copy interrupted): its complete samples are read, and the
+    CLI says so in one warning line of its own, not nptdms's two multi-line log records; the library puts the
+    same line in the frame's ``attrs["warnings"]``."""
+    import subprocess
+    import sys
+
+    import fruitimpact as fi
+
+    rec = _recording(lanes=1)
+    whole = write_recording(rec, tmp_path / "whole.tdms")
+    cut = tmp_path / "cut.tdms"
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size * 2 // 3])
+    done = subprocess.run([sys.executable, "-m", "fruitimpact", "analyze", str(cut), "--json"], capture_output=True,
+                          text=True)
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("fruitimpact analyze: warning:") and "cut short" in lines[0]
+    frame = fi.analyze(cut)
+    assert frame.attrs["warnings"] == [lines[0].split(f"{cut.name}: ", 1)[1]]
+    assert fi.analyze(whole).attrs["warnings"] == []

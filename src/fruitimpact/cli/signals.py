@@ -128,6 +128,8 @@ def cmd_analyze(args) -> int:
         source = open_recording(args.file, rate=rate, column=args.column, format=args.format, lanes=lanes)
     except ValueError as exc:
         raise UsageError(_reading_error(exc, args)) from None
+    for note in source.notes:
+        print(f"{PROG} analyze: warning: {args.file}: {note}", file=sys.stderr, flush=True)
     from fruitimpact.signals import offline  # the detector and the fit (numba) once the file opened
     from fruitimpact.signals.analysis import public
     from fruitimpact.signals.stream import StreamAnalyzer

@@ -44,7 +44,8 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
         One row per contact in time order per lane, with the columns of ``fruitimpact analyze --json``
         (``lane``, ``start_time`` [s], ``peak_force`` [N], ``time_to_peak`` [s], ``contact_duration`` [s],
         ``firmness_c`` [N/s], ``firmness_c_star`` [N/s²], ``status``, ``rebound_of`` …; with ``fit`` the fitted
-        stiffness, restitution and, with a velocity or mass, the modulus).
+        stiffness, restitution and, with a velocity or mass, the modulus).  ``attrs["warnings"]``: what the
+        file's reader found odd but could read (a TDMS file cut short), one line each.
 
     Raises
     ------
@@ -66,7 +67,9 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
     import pandas as pd
 
     run = run_analysis(source, rate=rate, column=column, format=format, lanes=lanes, **options)
-    return pd.DataFrame(run.rows, columns=run.columns)
+    frame = pd.DataFrame(run.rows, columns=run.columns)
+    frame.attrs["warnings"] = list(run.notes)
+    return frame
 
 
 @dataclass
@@ -81,6 +84,7 @@ class AnalysisRun:
     start_time: float
     samples: int
     classes: object = None
+    notes: tuple = ()  # what the file's reader found odd but could read (RecordingSource.notes)
 
 
 def run_analysis(source, *, rate=None, column: str | None = None, format: str | None = None, lanes: int = 1,
@@ -116,6 +120,7 @@ def run_analysis(source, *, rate=None, column: str | None = None, format: str | 
     elif from_file:
         reader = open_recording(source, rate=rate_value, column=column, format=format, lanes=lanes)
         names, start, rate_value, samples = list(reader.lane_names), reader.start_time, reader.rate, None
+        notes = reader.notes
         chunks = reader.chunks(ANALYZE_CHUNK)
     else:
         if rate_value is None:
@@ -131,6 +136,8 @@ def run_analysis(source, *, rate=None, column: str | None = None, format: str | 
             raise InputError(f"source must be force samples of shape (n,) or (n, lanes), at least one sample and one "
                              f"lane; got shape {samples.shape}", "source")
         names, start, chunks = [f"lane{k}" for k in range(samples.shape[1])], 0.0, None
+    if not from_file or isinstance(source, Recording):
+        notes = ()
     if chunks is None:
         chunks = (samples[i:i + ANALYZE_CHUNK] for i in range(0, samples.shape[0], ANALYZE_CHUNK))
     settings, analysis = analysis_settings(rate_value, True, **options)
@@ -149,7 +156,7 @@ def run_analysis(source, *, rate=None, column: str | None = None, format: str | 
     # the same columns in the same order whatever the contacts (a quiet recording, a fit that never converged)
     columns = list(report_columns(analysis))
     columns += [key for key in dict.fromkeys(k for row in rows for k in row) if key not in columns]
-    return AnalysisRun(rows, columns, names, rate_value, start, samples_fed, analysis.classes)
+    return AnalysisRun(rows, columns, names, rate_value, start, samples_fed, analysis.classes, notes)
 
 
 def _watched(chunks, on_chunk):

@@ -180,6 +180,9 @@ class RecordingSource:
     samples : int or None
         Samples per lane, or None when only a full pass could tell (a CSV file longer than the rows read
         to find its rate).
+    notes : tuple of str
+        What the reader found odd but could read (a TDMS file's last segment cut short), one line each, for
+        the caller's warnings.
     """
 
     source: str
@@ -190,6 +193,7 @@ class RecordingSource:
     clip_low: float | None = None
     clip_high: float | None = None
     samples: int | None = None
+    notes: tuple[str, ...] = ()
     #: ``_blocks(hint)``: a fresh generator of float64 blocks (rows × lanes, C-contiguous) covering the
     #: file in order, of any length, each of at most max(hint, a reader's own block) rows.
     _blocks: Callable[[int], Iterator[np.ndarray]] = field(default=None, repr=False)

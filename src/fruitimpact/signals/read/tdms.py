@@ -52,13 +52,49 @@ def _nptdms(path):
     return TdmsFile
 
 
+class _NptdmsLog:
+    """While open, nptdms's log records are kept here instead of printed (two multi-line warnings on stderr for a
+    file cut short, in nptdms's words): ``notes()`` says them once, in ours."""
+
+    def __enter__(self):
+        import logging
+
+        self.records = []
+        handler = logging.Handler(logging.WARNING)
+        handler.emit = self.records.append
+        # nptdms gives each of its modules a logger with its own handler (nptdms.reader, nptdms.tdms_segment …)
+        names = ["nptdms"] + [name for name in logging.Logger.manager.loggerDict if name.startswith("nptdms.")]
+        self.saved = []
+        for name in names:
+            logger = logging.getLogger(name)
+            self.saved.append((logger, logger.propagate, list(logger.handlers)))
+            logger.propagate, logger.handlers = False, [handler]
+        return self
+
+    def __exit__(self, *exc):
+        for logger, propagate, handlers in self.saved:
+            logger.propagate, logger.handlers = propagate, handlers
+        return False
+
+    def notes(self) -> tuple[str, ...]:
+        texts = [record.getMessage() for record in self.records]
+        notes = []
+        if any("less data than expected" in text or "not a multiple of the chunk size" in text for text in texts):
+            notes.append("the last segment is cut short (the file was truncated, or is still being written): its "
+                         "complete samples are read, the rest of it is not")
+        notes += [f"nptdms: {' '.join(text.split())}" for text in texts
+                  if "less data than expected" not in text and "not a multiple of the chunk size" not in text]
+        return tuple(dict.fromkeys(notes))
+
+
 def open_tdms(path: Path, rate, column) -> RecordingSource:
     """Every channel of numbers (or the ``column``) as a lane ``group/channel``; see ``signals.read``."""
     if path.stat().st_size == 0:
         raise error(path, "empty file")
     tdms_file = _nptdms(path)
+    heard = _NptdmsLog()
     try:
-        with tdms_file.open(path) as tdms:  # the metadata stays readable once the file is closed
+        with heard, tdms_file.open(path) as tdms:  # the metadata stays readable once the file is closed
             # (lane name, group, channel, dtype, length, properties, the nptdms channel)
             channels = [(f"{group.name}/{channel.name}", group.name, channel.name, channel.dtype, len(channel),
                          dict(channel.properties), channel) for group in tdms.groups() for channel in group.channels()]
@@ -139,7 +175,7 @@ def open_tdms(path: Path, rate, column) -> RecordingSource:
 
     return RecordingSource(source=str(path), format="tdms", rate=rate, lane_names=names,
                            start_time=next(iter(starts.values())), clip_low=clip_low, clip_high=clip_high,
-                           samples=samples, _blocks=blocks)
+                           samples=samples, notes=heard.notes(), _blocks=blocks)
 
 
 # --------------------------------------------------------------------------- reading the samples
