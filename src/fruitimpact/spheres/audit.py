@@ -8,7 +8,8 @@ readings into transfer points and passes (``spheres.points``) and, per point, ta
   ``drop_height_max`` the largest equivalent drop of any reading of the point;
 * the **surface**: the median surface modulus of those landings, or *rigid* when most of them are rigid to
   the sphere (their modulus cannot be measured by it); ``surface`` names the library surface on which the
-  same sphere, dropped from that height, would read the nearest peak acceleration.
+  same sphere, dropped from that height, would read the nearest peak acceleration (on a rigid point: the
+  stiffest half-space, since all stiff ones read alike), ``surfaces_alike`` those it cannot tell apart.
 
 The lot (``line``'s options: ``fruit``, ``mass`` …, ``rows``, ``seed``, ``criterion``, the fruit's library
 spreads) is then dropped at every point as ``line`` drops it (``handling.line.audit``: same engine, same
@@ -29,13 +30,18 @@ import numpy as np
 TARGET = 0.05
 
 
-def _nearest_surfaces(sphere, velocity, restitution, peak) -> list[str]:
-    """Per point, the library surface on which ``sphere`` at ``velocity`` [m/s] with ``restitution`` would read
-    the peak acceleration nearest (in ratio) to ``peak`` [m/s²]; the engine drops the sphere on each."""
+def _nearest_surfaces(sphere, velocity, restitution, peak, rigid, spread) -> list[tuple[str, list[str]]]:
+    """Per point, (the nearest library surface, the surfaces alike): the engine drops ``sphere`` at ``velocity``
+    [m/s] with ``restitution`` on every library surface; those whose peak acceleration lies within ``spread``
+    (the readings' relative 95 % uncertainty) of the point's ``peak`` [m/s²] read alike to this sphere.  The
+    nearest is the one of least peak misfit — except on a point ``rigid`` to the sphere, where every stiff
+    half-space reads alike (steel, concrete, wood: none deforms beside a fruit or the sphere) and the noise alone
+    would pick among them: there it is the stiffest half-space."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.library.catalogue import surfaces
 
-    names = [name for name, entry in surfaces().items() if entry.partner is None]
+    library = surfaces()
+    names = [name for name, entry in library.items() if entry.partner is None]
     count = len(velocity)
     table = {"mass": np.full(count * len(names), sphere.mass), "diameter": np.full(count * len(names), sphere.diameter),
              # the sphere's own contact modulus E*_s = E_s/(1 − ν_s²) enters through E = E*_s and ν = 0
@@ -47,7 +53,18 @@ def _nearest_surfaces(sphere, velocity, restitution, peak) -> list[str]:
     with np.errstate(invalid="ignore", divide="ignore"):
         misfit = np.abs(np.log(predicted / np.asarray(peak)[:, None]))
     misfit = np.where(np.isfinite(misfit), misfit, np.inf)
-    return [names[int(np.argmin(row))] for row in misfit]
+    stiffness = {name: (entry.modulus.value / (1.0 - entry.poisson.value ** 2) if entry.model == "half-space"
+                        else -math.inf) for name, entry in library.items() if entry.partner is None}
+    answers = []
+    for row, is_rigid in zip(misfit, rigid):
+        alike = [names[k] for k in np.argsort(row) if row[k] <= spread]
+        if is_rigid:
+            candidates = [name for name in (alike or names) if library[name].model == "half-space"] or \
+                [name for name in names if library[name].model == "half-space"]
+            answers.append((max(candidates, key=stiffness.get), alike))
+        else:
+            answers.append((names[int(np.argmin(row))], alike))
+    return answers
 
 
 def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_diameter=None, sphere_modulus=None,
@@ -129,7 +146,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     from fruitimpact.library.catalogue import surfaces
     from fruitimpact.spheres.calibration import read_calibration
     from fruitimpact.spheres.devices import build_sphere
-    from fruitimpact.spheres.inversion import DEFAULT_UNCERTAINTY, invert
+    from fruitimpact.spheres.inversion import DEFAULT_UNCERTAINTY, Z95, invert
     from fruitimpact.spheres.log import read_log
     from fruitimpact.spheres.points import PASS_GAP, POINT_GAP, group, read_windows
 
@@ -264,13 +281,12 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     if not known:
         raise InputError(f"log: no reading of {log} is reproduced by an impact of this sphere ({result.message[0]})",
                          "log")
+    spread = Z95 * math.hypot(error, error)  # a peak's and a velocity's relative uncertainty, 95 %
     nearest = _nearest_surfaces(body, np.array([s["velocity"] for s in known]),
-                                np.array([s["restitution"] for s in known]), np.array([s["peak"] for s in known]))
-    for summary, surface in zip(known, nearest):
-        if summary["surface_modulus"] is None and surfaces()[surface].model != "half-space":
-            # rigid to the sphere but nearest a cushion: the sphere's peak says stiff; drop the lot on a rigid flat
-            surface = next(name for name, entry in surfaces().items() if entry.model == "half-space")
-        summary["surface"] = surface
+                                np.array([s["restitution"] for s in known]), np.array([s["peak"] for s in known]),
+                                [s["surface_modulus"] is None for s in known], spread)
+    for summary, (surface, alike) in zip(known, nearest):
+        summary["surface"], summary["alike"] = surface, alike
     line_points = []
     for name, summary in zip(groups.names, summaries):
         if summary is None:
@@ -304,7 +320,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                      drop_height_low=summary["drop_height_low"], drop_height_high=summary["drop_height_high"],
                      velocity=summary["velocity"], restitution=summary["restitution"],
                      surface_modulus=summary["surface_modulus"], rigid=summary["surface_modulus"] is None,
-                     surface=summary["surface"], incidence=line["incidence"],
+                     surface=summary["surface"], surfaces_alike=summary["alike"], incidence=line["incidence"],
                      bruise_volume=line["mean_bruise_volume"], mean_peak_force=line["mean_peak_force"],
                      cumulative_incidence=line["cumulative_incidence"],
                      cumulative_bruise_volume=line["cumulative_bruise_volume"], status="ok",
