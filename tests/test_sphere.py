@@ -399,3 +399,31 @@ def test_options_the_reader_may_get_wrong(tmp_path):
     assert refused.returncode == 2 and "overlap" in refused.stderr
     used = run("sphere", log, *SPHERE_OPTIONS, "--sphere-restitution", "0.5", "--fruit", "apple", "-n", 10)
     assert "--sphere-restitution is not used" in used.stderr
+
+
+def test_a_pulse_that_is_not_a_hertz_impact_is_said_so(tmp_path):
+    """A trace of the sphere bottoming out a foam pad (the engine's own layer model, an independent shape: soft,
+    then hard) is not a Hunt-Crossley impact on a half-space; its three numbers still fit one, at the wrong drop
+    height (a 10 cm drop reads about 5 cm), so its message and a warning say the shape does not fit, while
+    the Hertz pulses of the same trace pass unflagged (their fit misses by the noise alone)."""
+    import fruitimpact as fi
+
+    rate = 20_000.0
+    rng = np.random.default_rng(1)
+    pieces = []
+    for surface, height in (("foam-pad", 0.10), ("steel", 0.10), ("rubber-belt", 0.10)):
+        curves = fi.simulate(mass=MASS, diameter=DIAMETER, modulus=SPHERE_CONTACT, poisson=0.0, drop_height=height,
+                             restitution=0.6, surface=surface).curves
+        t = np.arange(0.0, curves.time[-1], 1.0 / rate)
+        pieces += [np.full(int(1.5 * rate), 1.0), 1.0 + np.interp(t, curves.time, curves.force) / MASS / G0]
+    pieces.append(np.full(int(0.5 * rate), 1.0))
+    trace = np.concatenate(pieces) + 0.3 * rng.standard_normal(sum(map(len, pieces)))
+    log = tmp_path / "foam.csv"
+    log.write_text("time,acceleration\n" + "".join(f"{k / rate:.6f},{v:.4f}\n" for k, v in enumerate(trace)))
+    report = fi.sphere_audit(log, sphere="is-1987", sphere_modulus=SPHERE_CONTACT, sphere_poisson=0.0,
+                             fruit="apple", rows=10)
+    foam, steel, rubber = report["impacts"]
+    assert "not a Hunt-Crossley impact on a half-space" in foam["message"]
+    assert "shape" not in steel["message"] and "shape" not in rubber["message"]
+    assert steel["drop_height"] == pytest.approx(0.10, rel=0.05) and rubber["drop_height"] == pytest.approx(0.10, rel=0.1)
+    assert any("not shaped as a Hunt-Crossley impact" in w for w in report["warnings"])

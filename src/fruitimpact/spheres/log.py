@@ -52,6 +52,8 @@ ACCELERATION_UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "m/s²":
 #: Readings beyond these are legal but implausible for a sphere on a handling line: one warning.
 IMPLAUSIBLE_PEAK = 2000.0 * STANDARD_GRAVITY
 IMPLAUSIBLE_CHANGE = 20.0
+#: A pulse's fit misfit counts as a shape the model does not have (``shape_misfit``) above this many noise sd.
+SHAPE_NOISE = 3.0
 #: A trace's sample times may differ from uniform by this share of the period.
 TRACE_JITTER = 0.01
 #: Most rows of one log (readings: a survey logs thousands; a raw trace: about 80 min at 10 kHz).  The reader
@@ -64,7 +66,8 @@ class SphereLog:
     """Readings of a log, SI: ``time`` [s], ``peak`` a_max [m/s²], ``change`` ΔV [m/s], ``duration`` T [s]
     (NaN where not logged), ``point`` (labels, or None), ``rows`` (the file's row number of each), ``skipped``
     ([(row, column, reason)]), ``kind`` (``readings`` or ``trace``), ``sample_period`` [s] of a trace (0 for
-    readings), ``warnings``."""
+    readings), ``warnings``, ``shape_misfit`` (a trace's: the Hunt–Crossley fit's rms misfit over the peak where it
+    exceeds ``SHAPE_NOISE`` noise sd, else 0; None for readings)."""
 
     time: np.ndarray
     peak: np.ndarray
@@ -76,6 +79,7 @@ class SphereLog:
     kind: str = "readings"
     sample_period: float = 0.0
     warnings: list = field(default_factory=list)
+    shape_misfit: np.ndarray | None = None  # a trace's: rms misfit of each pulse's fit over its peak (0: within noise)
 
     def __len__(self) -> int:
         return self.time.size
@@ -336,7 +340,7 @@ def _trace(path, values, labels, good, numbers, skipped) -> SphereLog:
         raise ValueError(f"{path}: no impact found in the trace (none rises 6 noise σ and 2 g above its baseline)")
     from fruitimpact.signals.fit import fit_impact
 
-    peak, change, duration, times, rows, names = [], [], [], [], [], []
+    peak, change, duration, times, rows, names, misfit = [], [], [], [], [], [], []
     unfitted = 0
     for impact in found:
         start, end = impact.start_index, impact.end_index
@@ -350,17 +354,21 @@ def _trace(path, values, labels, good, numbers, skipped) -> SphereLog:
             peak.append(float(fit["peak_force"]))
             change.append(float(fit["impulse"]))
             duration.append(float(fit["contact_duration"]))
+            beyond = fit["fit_residual"] > SHAPE_NOISE * fit["noise"]
+            misfit.append(float(fit["fit_residual_relative"]) if beyond else 0.0)
         else:  # the samples themselves: the threshold-crossing contact
             unfitted += 1
             contact = window[start - impact.window_start: end - impact.window_start + 1]
             peak.append(float(contact.max()))
             change.append(float(np.sum(contact) * period))  # ∫ a dt over the contact (rectangle rule)
             duration.append((end - start + 1) * period)
+            misfit.append(math.nan)
         times.append(float(time[start]))
         rows.append(int(numbers[start]))
         names.append(labels[start] if labels is not None else None)
     log = SphereLog(np.array(times), np.array(peak), np.array(change), np.array(duration),
-                    names if labels is not None else None, np.array(rows), [], "trace", period)
+                    names if labels is not None else None, np.array(rows), [], "trace", period,
+                    shape_misfit=np.array(misfit))
     if unfitted:
         log.warnings.append(f"{unfitted} of {len(found)} impacts of the trace could not be fitted by a Hunt-Crossley "
                             f"pulse: their readings are the samples' (threshold-crossing duration, cut tails)")
