@@ -627,3 +627,68 @@ def test_integer_options_are_read_as_integers(argv, line, script, tmp_path):
     one line (exit 2), like every other count (impact.validation.read_count)."""
     done = script(*argv, cwd=tmp_path)
     assert done.returncode == 2 and done.stderr.strip().endswith(line), done.stderr
+
+
+# ------------------------------------------------------------------ simulate from the console, without numba
+_INTERPRETED_CASES = [
+    [], ["--drop-height", "30cm", "--fruit", "apple", "--surface", "steel", "--criterion", "shear"],
+    ["--model", "lankarani-nikravesh", "--calibration", "paper", "--restitution", "0.3"],
+    ["--model", "tsuji"], ["--model", "kelvin-voigt"], ["--criterion", "pressure", "--failure-stress", "0.3MPa"],
+    ["--fruit", "apple", "--surface", "rubber-belt", "--yield-pressure", "0.32MPa", "--criterion", "shear"],
+    ["--fruit", "apple", "--surface", "cardboard", "--drop-height", "30cm", "--criterion", "shear"],
+    ["--surface", "fruit", "--fruit", "apple"], ["--restitution", "0.001"], ["--velocity", "1e-9"],
+    ["--mass", "180kg"], ["--model", "kuwabara-kono"], ["--method", "rk4"],
+]
+
+
+@pytest.mark.parametrize("arguments", _INTERPRETED_CASES, ids=lambda a: " ".join(a) or "defaults")
+def test_simulate_interpreted_prints_what_compiled_prints(tmp_path, arguments):
+    """Issue 15 item 4: the console's `simulate` runs the engine's own functions interpreted, numba never started
+    (cli.interpreted).  It must print what the compiled engine prints: the table byte for byte (6 significant
+    digits), the JSON numbers to 1e-14 relative (the last bits of libm and of LLVM's code differ), the warnings
+    once each, also where interpretation hands over to the compiled engine (Kuwabara–Kono: over its time budget)
+    and with --plot/--csv, whose curves are computed before anything is printed."""
+    import os
+    import subprocess
+    import sys
+
+    def run(extra, compiled):
+        environment = {**os.environ, "FRUITIMPACT_COMPILED": "1" if compiled else "0"}
+        done = subprocess.run([sys.executable, "-m", "fruitimpact", "simulate", *arguments, *extra],
+                              capture_output=True, text=True, env=environment, cwd=tmp_path)
+        return done.returncode, done.stdout, done.stderr
+
+    # curves too where they matter: the defaults, a hand-over to compiled, a case with warnings (each run with a
+    # figure imports matplotlib: 1 s)
+    drawn = arguments in ([], ["--model", "kuwabara-kono"], ["--mass", "180kg"])
+    for extra in ([], ["--plot", "f.png", "--csv", "c.csv"]) if drawn else ([],):
+        assert run(extra, False) == run(extra, True)
+    code, text, _ = run(["--json"], False)
+    compiled_code, compiled_text, _ = run(["--json"], True)
+    assert code == compiled_code and code in (0, 1)
+    interpreted, compiled = json.loads(text), json.loads(compiled_text)
+    assert interpreted.keys() == compiled.keys()
+    for key, value in interpreted.items():
+        if isinstance(value, float) and isinstance(compiled[key], float):
+            assert value == pytest.approx(compiled[key], rel=1e-14, abs=1e-300), key
+        else:
+            assert value == compiled[key], key
+
+
+def test_simulate_from_the_console_starts_no_numba(tmp_path):
+    """The interpreted path is the one taken: Python's import log of `python -m fruitimpact simulate` names no
+    numba module (and FRUITIMPACT_COMPILED=1 brings numba back)."""
+    import os
+    import subprocess
+    import sys
+
+    def imported(compiled):
+        environment = {**os.environ, "FRUITIMPACT_COMPILED": compiled}
+        done = subprocess.run([sys.executable, "-X", "importtime", "-m", "fruitimpact", "simulate"],
+                              capture_output=True, text=True, env=environment)
+        assert done.returncode == 0, done.stderr
+        return [line for line in done.stderr.splitlines() if "| numba" in line or "|   numba" in line
+                or line.rstrip().endswith(" numba")]
+
+    assert imported("0") == []
+    assert imported("1")

@@ -132,9 +132,16 @@ def main(argv=None) -> int:
             _defer_numpy()  # before the first module that names NumPy
         from fruitimpact.cli.common import UsageError, _attach_negative_values, _numba_without_blas
 
+        interpreted = False
         if console:
             _redeliver_interrupts_from_callbacks()
-            _numba_without_blas()
+            from fruitimpact.cli import interpreted as engine_mode
+
+            interpreted = engine_mode.wanted(_command(argv))
+            if interpreted:  # one impact: the engine's functions run by Python, numba never started
+                engine_mode.interpret_engine()
+            else:
+                _numba_without_blas()
         parser = build_parser()
         argv = _attach_negative_values(argv)
         try:
@@ -142,7 +149,12 @@ def main(argv=None) -> int:
             if getattr(args, "func", None) is None:
                 parser.print_help()
                 return 2
-            return args.func(args)
+            if not interpreted:
+                return args.func(args)
+            try:
+                return args.func(args)
+            except engine_mode.Recompile:  # a value compiled code reads as inf or NaN: the same command, compiled
+                engine_mode.rerun_compiled(argv)
         except UsageError as exc:
             command = getattr(locals().get("args"), "command", None) or _command(argv)
             prefix = f"{PROG} {command}" if command else PROG

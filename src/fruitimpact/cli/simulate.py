@@ -93,6 +93,14 @@ def cmd_simulate(args) -> int:
     from fruitimpact.impact.simulation import simulate  # the engine (numba) only once the options are good
 
     result = _library_call(simulate, **kwargs)
+    results = [result]
+    if (args.csv or args.plot) and result.status != "failed":
+        # every engine call before the first line is printed: an interpreted run that must go compiled
+        # (cli.interpreted) starts again from scratch, and nothing may be printed twice
+        if args.plot:
+            results += [_library_call(simulate, **{**kwargs, **overlay}) for overlay in overlays]
+        for each in results:
+            _ = each.curves
     for warning in result.warnings:
         print(f"{PROG} simulate: warning: {warning}", file=sys.stderr)
     if args.csv and result.status != "failed":
@@ -100,7 +108,6 @@ def cmd_simulate(args) -> int:
     if args.plot and result.status != "failed":
         from fruitimpact.plotting import impact_figure, save_figure
 
-        results = [result] + [_library_call(simulate, **{**kwargs, **overlay}) for overlay in overlays]
         _library_call(save_figure, impact_figure(results, title="fruitimpact: impact of the fruit on the surface"),
                       args.plot, "--plot")
     if args.json:
