@@ -71,18 +71,12 @@ def read_line(path) -> list[TransferPoint]:
     import csv
     import os
 
+    from fruitimpact.impact.textfiles import table_lines
     from fruitimpact.impact.units import parse_quantity
 
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
         raise ValueError(f"line must be a path to a line CSV; got {path!r}")
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
-            lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"cannot read {path}: not a UTF-8 text file") from None
-    rows = list(csv.reader(lines))
+    rows = list(csv.reader(line for _, line in table_lines(path)))
     if not rows:
         raise ValueError(f"{path} is empty: expected a header {','.join(LINE_COLUMNS)}")
     header = [cell.strip().replace("-", "_") for cell in rows[0]]

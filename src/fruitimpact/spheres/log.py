@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import csv
 import math
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -137,16 +136,9 @@ def _cell(text: str, dimension: str, factor: float) -> float:
 def _table(path, mapping: dict, schema: dict, hint: str = "; map a vendor's headers with --columns name=Header"):
     """(our name of each header cell, unit factors, data rows with their line numbers); ``mapping`` as
     ``parse_columns`` returns it; ``hint`` ends the message of an unknown column."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise ValueError(f"log must be a path to a CSV file; got {path!r}")
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            lines = [(number, line) for number, line in enumerate(handle, start=1)
-                     if line.strip() and not line.lstrip().startswith("#")]
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"cannot read {path}: not a UTF-8 text file") from None
+    from fruitimpact.impact.textfiles import table_lines
+
+    lines = table_lines(path)
     if not lines:
         raise ValueError(f"{path} is empty: expected a header")
     if len(lines) - 1 > MAX_ROWS:

@@ -57,16 +57,10 @@ def read_windows(path) -> list[tuple[str, float, float]]:
     ``ValueError`` naming the file, line and column."""
     import csv
 
+    from fruitimpact.impact.textfiles import table_lines
     from fruitimpact.impact.units import parse_quantity
 
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            lines = [(n, line) for n, line in enumerate(handle, start=1)
-                     if line.strip() and not line.lstrip().startswith("#")]
-    except OSError as exc:
-        raise ValueError(f"points: cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"points: cannot read {path}: not a UTF-8 text file") from None
+    lines = table_lines(path, "points: ")
     rows = list(csv.reader(line for _, line in lines))
     if not rows or [c.strip() for c in rows[0]] != ["name", "start", "end"]:
         raise ValueError(f"points: {path} must have the header name,start,end")
