@@ -6,13 +6,15 @@ at which half the fruit bruise.
 **Volumes** (:func:`fit_volumes`; a measured bruise volume per test, 0 where the fruit did not bruise).  Fruit i
 hit with energy W_i has its own threshold T_i, lognormal around W_th with spread σ_t (ln T_i ~ N(ln W_th, σ_t²));
 it bruises when W_i > T_i, and then its volume is BV_i = BS (W_i − T_i) e^(σ_v ε_i), ε_i ~ N(0, 1) (a
-multiplicative scatter of the susceptibility and of the measurement).  Why this model:
+multiplicative scatter of the susceptibility and of the measurement).  BS is therefore the **median** volume per
+joule above a fruit's threshold: the mean is BS e^(σ_v²/2) (2 % more at σ_v = 0.2, 13 % at σ_v = 0.5).  The
+simulator's BV = BS (W − W_th)₊ with the fitted BS gives that median bruise.  Why this model:
 
 * an unbruised fruit is *censored*, not a zero of a line: all it says is T_i ≥ W_i, with probability
   1 − Φ((ln W_i − ln W_th)/σ_t).  A least-squares line through the zeros drags BS down and W_th below the energies
   that did not bruise;
-* the mean volume is the published BV = BS (W − W_th)₊ (Opara & Pathare 2014) for identical fruit (σ_t → 0), and
-  near the threshold it rises smoothly, as pooled data do, because only the weaker fruit bruise there;
+* the median volume is the published BV = BS (W − W_th)₊ (Opara & Pathare 2014) for identical fruit (σ_t → 0),
+  and near the threshold it rises smoothly, as pooled data do, because only the weaker fruit bruise there;
 * volumes are positive and scatter in proportion to their size, so the scatter is lognormal, not additive;
 * with no test below the threshold the model still fits BS and W_th from the volumes (the intercept of the line);
   the data then bound W_th only from above, and the fit says so.
@@ -34,7 +36,8 @@ that side; a threshold open below is then no estimate at all: the likelihood is 
 Profile intervals follow the likelihood where it is skewed (a threshold barely bracketed) and are invariant to the
 parametrisation; their coverage is checked by simulation in tests/test_fit_damage.py.
 The maximisation is Nelder–Mead (Gao & Han 2012 adaptive coefficients) in (ln BS, ln W_th, ln σ_t, ln σ_v), from
-several starts.
+several starts, on energies and volumes divided by their geometric means (the model is invariant to the units: a
+table in joules and cubic metres, or one of 1e-300 J, fits the same, with no linear algebra on raw values).
 
 References
 ----------
@@ -242,7 +245,8 @@ class BruiseFit:
         ``"volume"`` or ``"incidence"``.
     estimates : dict
         Name → maximum-likelihood estimate in SI, or None where the data do not determine it: ``bruise_energy``
-        W_th [J], ``bruise_susceptibility`` BS [m³/J] (volume model only), ``threshold_spread`` σ_t [-] and
+        W_th [J] (the median threshold), ``bruise_susceptibility`` BS [m³/J] (volume model only; the median volume
+        per joule above a fruit's threshold, the volume's scatter being lognormal), ``threshold_spread`` σ_t [-] and
         ``volume_scatter`` σ_v [-] (volume model only).
     intervals : dict
         Name → (low, high) of the 95 % profile-likelihood interval [SI]; an end is None where the data do not
@@ -252,7 +256,7 @@ class BruiseFit:
     status : str
         ``"ok"`` or ``"failed"`` (too few bruised or unbruised tests to fit; ``message`` says which).
     message : str
-        What was fitted, or why nothing could be.
+        What was fitted, or why nothing could be (a ``failed`` fit's message always says why).
     notes : list of str
         Caveats (a threshold not bounded on one side, a spread at the end of its search range).
     """
@@ -310,6 +314,8 @@ def _half_width(negative, theta_hat, value_hat, index):
                 theta[j] += b * h
                 values.append(negative(theta))
             hessian[i, j] = hessian[j, i] = (values[0] - values[1] - values[2] + values[3]) / (4.0 * h * h)
+    if not np.all(np.isfinite(hessian)):
+        return 0.2  # a step left the likelihood's finite region: no curvature (and no LAPACK on NaN)
     try:
         variance = np.linalg.inv(hessian)[index, index]
     except np.linalg.LinAlgError:
@@ -383,14 +389,16 @@ def fit_volumes(energy, volume) -> BruiseFit:
     Parameters
     ----------
     energy : array
-        Energy of each test W_i [J], > 0 (one basis for all: impact energy m g h of a drop, or a pendulum's).
+        Energy of each test W_i [J], > 0, on one basis for all (``handling.droptests`` passes the energy the
+        simulator compares with the threshold: the fruit's share of the impact energy on each test's surface).
     volume : array
         Bruise volume of each test BV_i [m³], ≥ 0; 0: the fruit did not bruise (a censored threshold).
 
     Returns
     -------
     BruiseFit
-        ``estimates`` and ``intervals`` of ``bruise_susceptibility`` [m³/J] and ``bruise_energy`` [J], with
+        ``estimates`` and ``intervals`` of ``bruise_susceptibility`` [m³/J] (the median volume per joule above a
+        fruit's threshold; the mean is e^(σ_v²/2) times it) and ``bruise_energy`` [J] (the median threshold), with
         ``threshold_spread`` and ``volume_scatter``; ``status`` ``failed`` with fewer than ``MIN_BRUISED`` bruised
         tests.
 
@@ -407,24 +415,37 @@ def fit_volumes(energy, volume) -> BruiseFit:
         return BruiseFit("volume", _empty("volume"), {}, math.nan, "failed",
                          f"{count} of {energy.size} tests bruised: a volume fit needs at least {MIN_BRUISED} bruised "
                          f"tests (bruise susceptibility, threshold and volume scatter){above}")
-    ln_w = np.log(energy)
-    ln_wb, ln_v, ln_wu = ln_w[bruised], np.log(volume[bruised]), ln_w[~bruised]
+    # in units of the tests' own geometric means (the model is scale-invariant): W' = W/w0, V' = V/v0, so that
+    # ln BS = ln BS' + ln(v0/w0), ln W_th = ln W_th' + ln w0 (the spreads are ratios: unchanged), and ℓ with volumes
+    # in m³ is ℓ' − (bruised tests) ln v0
+    ln_w0 = float(np.mean(np.log(energy)))
+    ln_v0 = float(np.mean(np.log(volume[bruised])))
+    ln_w = np.log(energy) - ln_w0
+    ln_wb, ln_v, ln_wu = ln_w[bruised], np.log(volume[bruised]) - ln_v0, ln_w[~bruised]
     th_low, th_high = _box(ln_w)
     ratio = ln_v - ln_wb
     low = np.array([ratio.min() - 10.0, th_low, math.log(SPREAD_BOUNDS[0]), math.log(SPREAD_BOUNDS[0])])
     high = np.array([ratio.max() + 10.0, th_high, math.log(SPREAD_BOUNDS[1]), math.log(SPREAD_BOUNDS[1])])
     negative = _penalised(lambda theta: _volume_terms(theta, ln_wb, ln_v, ln_wu), low, high)
-    theta, value = _best_of(negative, [np.clip(start, low, high) for start in _volume_starts(energy, volume, bruised)],
-                            np.full(4, 0.3))
-    intervals, notes = {}, []
+    starts = _volume_starts(np.exp(ln_w), _scattered(bruised, np.exp(ln_v)), bruised)
+    theta, value = _best_of(negative, [np.clip(start, low, high) for start in starts], np.full(4, 0.3))
+    shift = np.array([ln_v0 - ln_w0, ln_w0, 0.0, 0.0])  # scaled θ → θ in SI
+    intervals = {}
     for index, name in ((0, "bruise_susceptibility"), (1, "bruise_energy")):
         ends = _profile(negative, theta, index, value, low, high)
-        intervals[name] = tuple(None if end is None else math.exp(end) for end in ends)
-    estimates = {"bruise_susceptibility": math.exp(theta[0]), "bruise_energy": math.exp(theta[1]),
+        intervals[name] = tuple(None if end is None else math.exp(end + shift[index]) for end in ends)
+    estimates = {"bruise_susceptibility": math.exp(theta[0] + shift[0]), "bruise_energy": math.exp(theta[1] + shift[1]),
                  "threshold_spread": math.exp(theta[2]), "volume_scatter": math.exp(theta[3])}
-    notes += _bound_notes(theta, low, high, energy, estimates, intervals, ("threshold_spread", "volume_scatter"))
-    return BruiseFit("volume", estimates, intervals, -value, "ok",
+    notes = _bound_notes(theta, low, high, energy, estimates, intervals, ("threshold_spread", "volume_scatter"))
+    return BruiseFit("volume", estimates, intervals, -value - count * ln_v0, "ok",
                      f"volume model fitted to {energy.size} tests ({count} bruised)", notes)
+
+
+def _scattered(bruised, values):
+    """``values`` (one per bruised test) put back at the bruised tests' places, 0 elsewhere."""
+    out = np.zeros(bruised.size)
+    out[bruised] = values
+    return out
 
 
 def _volume_starts(energy, volume, bruised):
@@ -434,7 +455,10 @@ def _volume_starts(energy, volume, bruised):
     wb, vb = energy[bruised], volume[bruised]
     guesses = [0.5 * wb.min()]
     if wb.size >= 2 and np.ptp(wb) > 0.0:
-        slope, intercept = np.polyfit(wb, vb, 1)
+        # the least-squares line written out (no LAPACK: scaled values, and nothing for it to complain about)
+        dw = wb - wb.mean()
+        slope = float(np.sum(dw * (vb - vb.mean())) / np.sum(dw * dw))
+        intercept = float(vb.mean() - slope * wb.mean())
         if slope > 0.0 and 0.0 < -intercept / slope < wb.min():
             guesses.append(-intercept / slope)
     unbruised = energy[~bruised]
@@ -516,7 +540,8 @@ def fit_incidence(energy, bruised) -> BruiseFit:
         return BruiseFit("incidence", _empty("incidence"), {}, math.nan, "failed",
                          f"{count} of {energy.size} tests bruised: the threshold is {side}; the tests must include "
                          f"bruised and unbruised fruit")
-    ln_w = np.log(energy)
+    ln_w0 = float(np.mean(np.log(energy)))  # in units of the tests' geometric mean energy (scale-invariant)
+    ln_w = np.log(energy) - ln_w0
     ln_wb, ln_wu = ln_w[yes], ln_w[~yes]
     th_low, th_high = _box(ln_w)
     low = np.array([th_low, math.log(SPREAD_BOUNDS[0])])
@@ -536,8 +561,8 @@ def fit_incidence(energy, bruised) -> BruiseFit:
         starts = [np.array([float(np.median(ln_w)), math.log(s)]) for s in (0.1, 0.5)]
         theta, value = _best_of(negative, starts, np.array([0.2, 0.3]))
     ends = _profile(negative, theta, 0, value, low, high)
-    intervals = {"bruise_energy": tuple(None if end is None else math.exp(end) for end in ends)}
-    estimates = {"bruise_energy": math.exp(theta[0]), "threshold_spread": math.exp(theta[1])}
+    intervals = {"bruise_energy": tuple(None if end is None else math.exp(end + ln_w0) for end in ends)}
+    estimates = {"bruise_energy": math.exp(theta[0] + ln_w0), "threshold_spread": math.exp(theta[1])}
     if not separated:
         notes += _bound_notes(np.array([0.0, *theta]), np.array([0.0, *low]), np.array([0.0, *high]), energy,
                               estimates, intervals, ("threshold_spread",))

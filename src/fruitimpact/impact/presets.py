@@ -267,7 +267,15 @@ def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: 
         lot = lot_spreads(fruit, given, bruise=criterion not in (None, "none"))
     except ValueError as exc:
         raise InputError(str(exc), "fruit") from None
-    return lot.distributions, lot.diameter_density, lot.described
+    described = lot.described
+    fitted = library.fitted_criterion(library.fruits()[fruit]) if library.is_fruit_file(fruit) else None
+    drawn = {name for name, _ in lot.distributions}
+    if fitted is not None and criterion in ("pressure", "shear") and criterion != fitted and "failure_stress" in drawn:
+        # the lot's rows carry the drawn stress as given: the evaluation's warning of it is said here, once
+        described += (f"warning: failure_stress of the fruit file {fruit} was fitted under the {fitted} criterion "
+                      f"and is used here under {criterion}: the onset moves (give --criterion {fitted}, or a failure "
+                      f"stress fitted under {criterion})",)
+    return lot.distributions, lot.diameter_density, described
 
 
 __all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "lot_distributions", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",

@@ -37,9 +37,10 @@ from dataclasses import dataclass, fields
 from importlib import resources
 from types import MappingProxyType
 
-__all__ = ["ENERGY_BASED", "ENERGY_BASES", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS", "SURFACE_UNITS", "Fruit",
-           "FruitRegistry", "LibraryError", "Surface", "Value", "fruit", "fruit_file_text", "fruit_rows", "fruits",
-           "is_fruit_file", "load_fruit_file", "read_fruit_file", "surface", "surface_rows", "surfaces"]
+__all__ = ["ENERGY_BASED", "FILE_CHECKS", "ENERGY_BASES", "FITTED_BY", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS",
+           "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion", "fruit",
+           "fruit_file_text", "fruit_rows", "fruits", "is_fruit_file", "load_fruit_file",
+           "read_fruit_file", "surface", "surface_rows", "surfaces"]
 
 #: The numeric fields of a fruit and their SI units.
 FRUIT_UNITS = {
@@ -431,6 +432,9 @@ def read_fruit_file(path) -> Fruit:
         read, unknown or missing columns, a ragged line, not exactly one fruit, any check of the library's.
     """
     shown = os.fspath(path)
+    if os.path.isdir(path):
+        raise LibraryError(f"the fruit file {shown!r} is a directory, not a fruit file (a .csv in the fruit "
+                           f"library's format)")
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
             lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
@@ -454,7 +458,34 @@ def read_fruit_file(path) -> Fruit:
     if len(rows[1]) != len(header):
         raise LibraryError(f"fruit file {shown!r}: the fruit's row has {len(rows[1])} fields, the header "
                            f"{len(header)}")
-    return _fruit(dict(zip(header, rows[1])), 1, set(), f"fruit file {shown!r}")
+    entry = _fruit(dict(zip(header, rows[1])), 1, set(), f"fruit file {shown!r}")
+    _check_inputs(entry, shown)
+    return entry
+
+
+#: Checks every fruit file passes when it is loaded, beside the library's own rules: ``check(entry, shown)`` raises
+#: ``LibraryError``.  The checks of the options the file's values stand for live with those options (in
+#: ``impact.validation``, a layer above this package), which adds them here when it is imported: a fruit file is
+#: only ever resolved by the code that simulates with it, which imports it.
+FILE_CHECKS: list = []
+
+
+def _check_inputs(entry: Fruit, shown: str) -> None:
+    for check in FILE_CHECKS:
+        check(entry, shown)
+
+
+#: What the source of a value fitted by ``fruitimpact fit-damage`` says (``handling.droptests`` writes it).
+FITTED_BY = "fitted by fruitimpact fit-damage"
+
+
+def fitted_criterion(entry: Fruit) -> str | None:
+    """The criterion a fruit's failure stress was fitted under by ``fit-damage`` (its ``criterion`` column), or None
+    where the failure stress was not fitted (a library value, a bioyield stress, is no criterion's)."""
+    stress = entry.failure_stress
+    if stress is None or FITTED_BY not in stress.source:
+        return None
+    return entry.criterion
 
 
 def _cell(value) -> str:
@@ -488,9 +519,9 @@ def fruit_file_text(entry: Fruit, comment: str = "") -> str:
     return out.getvalue()
 
 
-#: Fruit files loaded so far: real path → ((inode, size, mtime), fruit), and fruit name → (real path, fruit).
+#: Fruit files loaded so far: real path → ((inode, size, mtime), fruit).  A file is found by its path only: its
+#: fruit's name is no key (what a name means must not depend on which files were loaded before).
 _FILES: dict = {}
-_NAMED: dict = {}
 
 
 def _numbers(entry: Fruit) -> tuple:
@@ -500,9 +531,10 @@ def _numbers(entry: Fruit) -> tuple:
 
 
 def load_fruit_file(path) -> Fruit:
-    """The fruit of the fruit file ``path`` (:func:`read_fruit_file`), registered under its name: ``fruits()[name]``
-    then finds it too.  Read again only when the file changed.  A fruit whose name is a library fruit's, or that of
-    a fruit loaded from another file, is accepted only with the same values (``_numbers``).
+    """The fruit of the fruit file ``path`` (:func:`read_fruit_file`), found again by its path only (never by its
+    fruit's name: two files may name their fruits alike, and a name means the same in every process).  Read again
+    only when the file changed.  A fruit whose name is a library fruit's is accepted only with the library fruit's
+    values (``_numbers``): a file's ``apple`` is the library's apple.
 
     Raises
     ------
@@ -511,6 +543,9 @@ def load_fruit_file(path) -> Fruit:
     """
     shown = os.fspath(path)
     real = os.path.realpath(path)
+    if os.path.isdir(real):
+        raise LibraryError(f"the fruit file {shown!r} is a directory, not a fruit file (a .csv in the fruit "
+                           f"library's format)")
     try:
         status = os.stat(real)
     except OSError as exc:
@@ -524,12 +559,7 @@ def load_fruit_file(path) -> Fruit:
     if library is not None and _numbers(library) != _numbers(entry):
         raise LibraryError(f"fruit file {shown!r} names its fruit {entry.name!r}, a fruit of the library with other "
                            f"values: give the fitted fruit another name")
-    other = _NAMED.get(entry.name)
-    if other is not None and other[0] != real and _numbers(other[1]) != _numbers(entry):
-        raise LibraryError(f"fruit file {shown!r} names its fruit {entry.name!r}, the name of the fruit of "
-                           f"{other[0]!r} with other values: give one of them another name")
     _FILES[real] = (stamp, entry)
-    _NAMED[entry.name] = (real, entry)
     return entry
 
 
@@ -537,10 +567,10 @@ class FruitRegistry(Mapping):
     """The fruit library as a read-only mapping, name → :class:`Fruit`, that also resolves fruit files.
 
     Iterating gives the library's fruits in file order (what ``fruitimpact fruits`` lists and messages name).
-    Looking up a path to an existing ``.csv`` file loads it (:func:`load_fruit_file`) and registers its fruit under
-    its name, which is then found too; so every ``fruit`` input (``--fruit``, a batch's ``fruit`` column, a Python
-    ``fruit=``) accepts a fruit file wherever it accepts a library name.  A file that breaks a rule is not in the
-    registry; :meth:`refusal` says why."""
+    Looking up a path to an existing ``.csv`` file loads it (:func:`load_fruit_file`); so every ``fruit`` input
+    (``--fruit``, a batch's ``fruit`` column, a Python ``fruit=``) accepts a fruit file wherever it accepts a library
+    name.  A file is found by its path only: the name of its fruit is not a fruit (whatever was loaded before).  A
+    file that breaks a rule is not in the registry; :meth:`refusal` says why."""
 
     def __init__(self, entries: dict[str, Fruit]):
         self.library = MappingProxyType(dict(entries))
@@ -550,9 +580,6 @@ class FruitRegistry(Mapping):
             entry = self.library.get(key)
             if entry is not None:
                 return entry
-            named = _NAMED.get(key)
-            if named is not None:
-                return named[1]
         if is_fruit_file(key) and os.path.isfile(key):
             return load_fruit_file(key)
         raise KeyError(key)
@@ -575,6 +602,9 @@ class FruitRegistry(Mapping):
         caller's own "must be one of" message applies)."""
         if not is_fruit_file(key) or key in self:
             return None
+        if os.path.isdir(key):
+            return (f"fruit must be one of {', '.join(self.library)} or a fruit file (.csv); {os.fspath(key)!r} is "
+                    f"a directory, not a file")
         if not os.path.isfile(key):
             return (f"fruit must be one of {', '.join(self.library)} or a fruit file (.csv); the file "
                     f"{os.fspath(key)!r} does not exist")
