@@ -324,8 +324,16 @@ def test_the_recording_page_in_a_real_browser(server, line_recording):
         assert page.evaluate("window.fruitimpact.last.contacts") == len(expected)
         assert page.locator("#impacts tbody tr").count() == len(expected)
         # a click on an impact: its curve with the fitted model over it
-        page.click('#impacts tbody tr[data-index="4"]')
-        _wait(page, "window.fruitimpact.impact.index === 4")
+        # the click's request races a re-analysis the page may still start from its inputs' change events (then
+        # the answer belongs to a replaced analysis and is dropped): click again until the impact is shown
+        for attempt in range(4):
+            page.click('#impacts tbody tr[data-index="4"]')
+            try:
+                _wait(page, "window.fruitimpact.impact !== null && window.fruitimpact.impact.index === 4", 20)
+                break
+            except AssertionError:
+                if attempt == 3:
+                    raise
         assert page.locator("#chart-impact path").count() >= 2  # samples and model
         peak = float(page.text_content("#impact-numbers tr:first-child td.value").replace(",", ""))
         assert peak == pytest.approx(expected["peak_force"][4], rel=1e-3)  # 4 significant digits shown
