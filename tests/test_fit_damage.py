@@ -380,7 +380,7 @@ def test_a_bruise_diameter_becomes_the_cap_of_the_librarys_bruise_geometry():
                                   "mass": ["180g", "175g", "190g", "180g", "180g"],
                                   "diameter": ["75mm", "", "80mm", "75mm", ""],
                                   "bruise_diameter": ["18mm", "0", "25mm", "1.2mm", "3mm"]})
-    volumes, ok, failed = droptests._diameter_volumes(table, "apple")
+    volumes, ok, failed = droptests.impacts._diameter_volumes(table, "apple")
     assert ok.all() and not failed
     shapes = []
     for k in range(5):
