@@ -43,8 +43,9 @@ from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_
 from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_forms
 from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from fruitimpact.impact.labels import Labels
+from fruitimpact.impact import fruitfiles
 from fruitimpact.impact.validation import (InputError, MessageBook, WarningBook, choice_message, conflict_message,
-                                           fruit_file_warnings, implausible_message, nan_message, range_message)
+                                           implausible_message, nan_message, range_message)
 
 #: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is
 #: ``damping``, given or calibrated).
@@ -244,7 +245,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             for j, name in enumerate(NUMERIC_INPUTS)}
     resolved = presets.resolve(inputs, GROUP_DEFAULTS["restitution"])
     resolved.apply(used, given)
-    _fruit_file_plausibility(inputs, resolved, warnings)
+    fruitfiles.plausibility(inputs, resolved, warnings)
     velocity = np.where(given["velocity"], values["velocity"],
                         np.where(given["drop_height"], np.sqrt(2.0 * STANDARD_GRAVITY * np.abs(values["drop_height"])),
                                  GROUP_DEFAULTS["velocity"]))
@@ -487,36 +488,6 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments, plastic_block)
 
 
-def _fruit_file_plausibility(inputs: InputColumns, resolved, warnings: WarningBook) -> None:
-    """The plausibility warnings a fruit file's values get, as the options they stand for do (where the row does
-    not give that input itself)."""
-    labels = {label for label in inputs.text["fruit"].labels if library.is_fruit_file(label)}
-    for label in sorted(labels):
-        rows = resolved.fruit_of == label
-        if not rows.any():
-            continue  # refused by the text check
-        for name, text in fruit_file_warnings(label):
-            warnings.add(rows & ~inputs.given[name], text)
-
-
-def _fitted_stress_warnings(inputs: InputColumns, resolved, where, name: str, messages: MessageBook,
-                            warnings: WarningBook) -> None:
-    """A failure stress fitted by fit-damage under one criterion, used under another (``name``): one warning per
-    fruit file, naming the file and both criteria (the stress at onset differs between criteria)."""
-    files = sorted(label for label in inputs.text["fruit"].labels if library.is_fruit_file(label))
-    if not files:
-        return
-    using = where & ~inputs.given["failure_stress"] & ~messages.flagged
-    fruits = library.fruits()
-    for label in files:
-        fitted = library.fitted_criterion(fruits[label]) if label in fruits else None
-        if fitted is not None and fitted != name:
-            warnings.add(using & (resolved.fruit_of == label),
-                         f"failure_stress of the fruit file {label} was fitted under the {fitted} criterion and is "
-                         f"used here under {name}: the onset moves (give --criterion {fitted}, or a failure stress "
-                         f"fitted under {name})")
-
-
 def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness, messages: MessageBook,
                          warnings: WarningBook) -> None:
     """Refusals that need the presets: layers without a usable thickness, bruise inputs without a
@@ -555,7 +526,7 @@ def _check_damage_inputs(inputs: InputColumns, resolved, layer, used, thickness,
             messages.set(where & given["bruise_energy"] & ~(inputs.values["bruise_energy"] > 0.0) & ~messages.flagged,
                          "bruise_energy must be > 0 J for the energy criterion (its threshold)", "bruise_energy")
         if name in ("pressure", "shear"):
-            _fitted_stress_warnings(inputs, resolved, where, name, messages, warnings)
+            fruitfiles.fitted_stress_warnings(inputs, resolved, where, name, messages, warnings)
             lacking = where & resolved.missing["failure_stress"] & ~given["failure_stress"] & ~messages.flagged
             for fruit in sorted(set(resolved.fruit_of[lacking])):
                 messages.set(lacking & (resolved.fruit_of == fruit),
