@@ -5,7 +5,8 @@
 * ``powerlaw``: the exact (quadrature) engine of F = K δ^n (1 + c δ̇): Hertz with Hunt–Crossley,
   Lankarani–Nikravesh and the other power-law damping laws;
 * ``plastic``: the exact engine of elastic–plastic contact (Thornton's flattened spot, the bioyield
-  element) on a half-space or a thin layer, and cardboard crushing;
+  element) on a half-space or a thin layer, and cardboard crushing; ``halfspace``: the same impact on a
+  half-space walked in the speed (closed-form forces, no inversions: its fast path);
 * ``adaptive``: adaptive Runge–Kutta with event location, for the laws with no first integral (Tsuji,
   Kuwabara–Kono, linear Kelvin–Voigt);
 * ``rk4``: the founding paper's fixed-step RK4 (section 3), to reproduce its method;

@@ -59,6 +59,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
+from fruitimpact.engine.halfspace import halfspace_impact
 from fruitimpact.engine.powerlaw import r_func
 from fruitimpact.engine.quadrature import gauss_jacobi
 
@@ -66,6 +67,10 @@ _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 
 #: Gauss–Legendre nodes per piece of a time integral (the integrands are smooth after substitution).
 NODES = 24
+#: A half-space impact is walked in the speed (``halfspace``) while c w < this (w the exit speed): beyond it
+#: (restitution ≲ 1/(c V), a damping far outside fruit) ln(1 − c u) is singular next to the exit and the
+#: force parametrisation is kept.  Below it the two agree to 1e-8 (tests/test_plastic.py).
+HALFSPACE_DAMPING_LIMIT = 0.9
 #: Rows from which the parallel kernel is used.
 PARALLEL_MIN_ROWS = 2000
 
@@ -481,19 +486,9 @@ def _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, l
 
 
 @nb.njit(**_JIT)
-def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness,
-                thickness, c, nodes, weights, out, extra):
-    """One impact: the characteristics into ``out`` (``codes.CHARACTERISTIC_COLUMNS``) and
-    ``PLASTIC_COLUMNS`` into ``extra``.  ``yield_pressure`` = inf: elastic fruit;
-    ``layer_stiffness`` = inf: a half-space surface (no layer)."""
-    p, energy, F_star = _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
-                               layer_stiffness, thickness, c)
-    df_star = _fruit_load(F_star, p)[0]
-    dl_star = _layer(F_star, p)[0]
-    loaded = load_work(F_star, p)
-    returned = unload_energy(F_star, p)
-    exit_speed = rebound_speed_of_energy(mass, c, returned)
-
+def _layered_impact(mass, c, energy, returned, p, F_star, yield_pressure, nodes, weights):
+    """(peak force, peak pressure, time to peak, time to the largest deflection, unloading time) walking each
+    branch in the force F_T: the fruit in series with a layer (any surface, the general path)."""
     # peak force F_T (1 + c v) and peak pressure: at F* without damping; else at a stationary point
     if c > 0.0:
         peak, F_peak_T = _largest(mass, c, energy, p, F_star, False, yield_pressure)
@@ -508,6 +503,37 @@ def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressu
             if not (F_peak_T < p[FY_] < F_star or F_peak_T < p[FB_] < F_star) else \
             time_to_max - _branch_time(F_peak_T, F_star, False, mass, c, energy, p, nodes, weights)
     unload_time = _branch_time(F_star, F_star, True, mass, c, returned, p, nodes, weights)
+    return peak, pressure, time_to_peak, time_to_max, unload_time
+
+
+@nb.njit(**_JIT)
+def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness,
+                thickness, c, nodes, weights, out, extra):
+    """One impact: the characteristics into ``out`` (``codes.CHARACTERISTIC_COLUMNS``) and
+    ``PLASTIC_COLUMNS`` into ``extra``.  ``yield_pressure`` = inf: elastic fruit;
+    ``layer_stiffness`` = inf: a half-space surface (no layer)."""
+    p, energy, F_star = _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
+                               layer_stiffness, thickness, c)
+    df_star = _fruit_load(F_star, p)[0]
+    dl_star = _layer(F_star, p)[0]
+    loaded = load_work(F_star, p)
+    returned = unload_energy(F_star, p)
+    exit_speed = rebound_speed_of_energy(mass, c, returned)
+
+    if not layer_stiffness < math.inf and c * exit_speed < HALFSPACE_DAMPING_LIMIT:
+        # a half-space: every work inverts in closed form, walk in the speed
+        v_yield, v_branch = 0.0, 0.0
+        if F_star > p[FY_]:
+            W_y = load_work(p[FY_], p)
+            v_yield = speed_of_energy(mass, c, energy - W_y)
+            # the plastic line F² = F_y² + 2 kp (W − W_y) continued back to F = 0, at W_y − F_y²/(2 kp) > 0
+            v_branch = speed_of_energy(mass, c, energy - W_y + 0.5 * p[FY_] * p[FY_] / p[KP_])
+        peak, pressure, time_to_peak, time_to_max, unload_time = halfspace_impact(
+            mass, velocity, c, stiffness, p[FY_], p[DY_], p[KP_], p[KU_], radius, yield_pressure, F_star, v_yield,
+            v_branch, exit_speed, nodes, weights)
+    else:
+        peak, pressure, time_to_peak, time_to_max, unload_time = _layered_impact(
+            mass, c, energy, returned, p, F_star, yield_pressure, nodes, weights)
     a_star = _pressure_at(F_star, p, yield_pressure)[1]
     out[0] = peak
     out[1] = time_to_peak
