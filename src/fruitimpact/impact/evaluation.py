@@ -206,14 +206,17 @@ def in_slices(kernel, *args):
     rows = next(a.shape[0] for a in args if isinstance(a, np.ndarray) and a.ndim >= 1)
     if rows <= KERNEL_SLICE:
         return kernel(*args)
-    parts = []
+    joined = None
     for start in range(0, rows, KERNEL_SLICE):
         stop = min(start + KERNEL_SLICE, rows)
-        parts.append(kernel(*(a[start:stop] if isinstance(a, np.ndarray) and a.ndim >= 1 and a.shape[0] == rows
-                              else a for a in args)))
-    if isinstance(parts[0], tuple):
-        return tuple(np.concatenate(pieces) for pieces in zip(*parts))
-    return np.concatenate(parts)
+        part = kernel(*(a[start:stop] if isinstance(a, np.ndarray) and a.ndim >= 1 and a.shape[0] == rows
+                        else a for a in args))
+        pieces = part if isinstance(part, tuple) else (part,)
+        if joined is None:  # the whole result allocated once, each slice written in place (no list to join)
+            joined = tuple(np.empty((rows, *piece.shape[1:]), dtype=piece.dtype) for piece in pieces)
+        for whole, piece in zip(joined, pieces):
+            whole[start:stop] = piece
+    return joined if isinstance(part, tuple) else joined[0]
 
 
 def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: bool | None = None,
