@@ -261,42 +261,52 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
     last = first + max(int((span - 0.5 * min(durations)) / step), 4)
     grid = np.unique(np.linspace(first + 3, last, GRID_ONSETS).round().astype(int))
     grid = [int(k) for k in grid[grid < n]]
-    shapes, rows, index = {}, [], {}
     model = PulseModel(ts - ts[0])
+    # the unit pulses (peak 1): each shape (duration, x) once, shifted to each onset (the contact's first sample
+    # and the grid); row of (shape s, onset o) = s × onsets + o
+    shapes = [(duration, 1.0) for duration in durations] + \
+        [(math.exp(guess["log_duration"]), guess["x"]) for guess in expected]
+    onsets = [first, *grid]
+    matrix = np.zeros((len(shapes) * len(onsets), n))
+    for s_index, (duration, x) in enumerate(shapes):
+        shape = model.pulse((0.0, 0.0, math.log(duration), x))
+        for o_index, at in enumerate(onsets):
+            matrix[s_index * len(onsets) + o_index, at:] = shape[:n - at]
+    n_d, n_g, n_o = len(durations), len(grid), len(onsets)
+    generic = np.arange(n_d)
+    grid_rows = np.arange(1, n_o)
 
-    def unit(at: int, duration: float, x: float = 1.0) -> int:
-        """Row of the unit pulse (peak 1) of this duration and x starting at sample ``at``."""
-        key = (at, duration, x)
-        if key not in index:
-            if (duration, x) not in shapes:
-                shapes[duration, x] = model.pulse((0.0, 0.0, math.log(duration), x)).copy()
-            row = np.zeros(n)
-            row[at:] = shapes[duration, x][:n - at]
-            index[key] = len(rows)
-            rows.append(row)
-        return index[key]
+    def row(shape_index, onset_index):
+        return shape_index * n_o + onset_index
 
-    # (row A, row B, duration A, duration B, x A, x B, expected k or −1, the pulse it is, B's onset sample);
-    # A starts with the contact
-    pairs = []
-    for at in grid:
-        for duration_a in durations:
-            for duration_b in durations:
-                pairs.append((unit(first, duration_a), unit(at, duration_b), duration_a, duration_b, 1.0, 1.0, -1, 0,
-                              at))
-    for k, guess in enumerate(expected):
-        duration_r, x_r = math.exp(guess["log_duration"]), guess["x"]
-        for at in grid:
-            for duration in durations:
-                pairs.append((unit(first, duration), unit(at, duration_r, x_r), duration, duration_r, 1.0, x_r, k, 1,
-                              at))
-                pairs.append((unit(first, duration_r, x_r), unit(at, duration), duration_r, duration, x_r, 1.0, k, 0,
-                              at))
-    table = np.array(pairs)
+    # the pairs, in the order of the loops they replace: (row A, row B, duration A, duration B, x A, x B,
+    # expected k or −1, the pulse it is, B's onset sample); A starts with the contact
+    blocks = []
+    at_g, da_g, db_g = np.meshgrid(np.arange(n_g), generic, generic, indexing="ij")  # at, duration A, duration B
+    at_g, da_g, db_g = at_g.ravel(), da_g.ravel(), db_g.ravel()
+    blocks.append(np.column_stack([row(da_g, 0), row(db_g, grid_rows[at_g]), np.take(durations, da_g),
+                                   np.take(durations, db_g), np.ones(at_g.size), np.ones(at_g.size),
+                                   np.full(at_g.size, -1.0), np.zeros(at_g.size), np.take(grid, at_g)]))
+    for k in range(len(expected)):
+        duration_r, x_r = shapes[n_d + k]
+        at_k, d_k = np.meshgrid(np.arange(n_g), generic, indexing="ij")
+        at_k, d_k = at_k.ravel(), d_k.ravel()
+        size = at_k.size
+        fruit_first = np.column_stack([row(d_k, 0), row(n_d + k, grid_rows[at_k]), np.take(durations, d_k),
+                                       np.full(size, duration_r), np.ones(size), np.full(size, x_r),
+                                       np.full(size, float(k)), np.ones(size), np.take(grid, at_k)])
+        rebound_first = np.column_stack([np.full(size, row(n_d + k, 0)), row(d_k, grid_rows[at_k]),
+                                         np.full(size, duration_r), np.take(durations, d_k), np.full(size, x_r),
+                                         np.ones(size), np.full(size, float(k)), np.zeros(size),
+                                         np.take(grid, at_k)])
+        pairs_k = np.empty((2 * size, 9))
+        pairs_k[0::2], pairs_k[1::2] = fruit_first, rebound_first
+        blocks.append(pairs_k)
+    table = np.concatenate(blocks)
+    pairs = table  # (its length is what the rest reads)
     a, b = table[:, 0].astype(int), table[:, 1].astype(int)
     # row by row (einsum's own loops: a BLAS product this small would wake BLAS's threads, which then spin
     # beside the stream on a small machine)
-    matrix = np.array(rows)
     norms, projection = np.einsum("ij,ij->i", matrix, matrix), np.einsum("ij,j->i", matrix, y)
     aa, bb, ay, by = norms[a], norms[b], projection[a], projection[b]
     ab = np.einsum("ij,ij->i", matrix[a], matrix[b])
@@ -326,17 +336,21 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
                 best[take], on[take] = value[take], (k, pulse)
         prior_chi2 = best
     score = np.where(good, chi2 + prior_chi2, np.inf)
-    ranked = [i for i in np.argsort(score, kind="stable") if np.isfinite(score[i])]
+    ranked = np.argsort(score, kind="stable")
+    ranked = ranked[np.isfinite(score[ranked])]
     # the best start of each hypothesis (which expected rebound is which pulse, with that rebound's own pulse or
     # a generic one) first, the rebound's own pulse before the generic: the grid's coarse χ² alone would spend
     # every fit on one hypothesis, and a generic pulse as the rebound can lead into a valley where the rebound
     # took the fruit's tail (χ² 234 against 210 for the right pair, in one case of tests/test_signals_rebounds)
-    firsts = {}
-    for i in ranked:
-        firsts.setdefault((int(table[i, 6] < 0), int(on[i, 0]), int(on[i, 1])), i)
+    keys = np.column_stack([(table[ranked, 6] < 0).astype(int), on[ranked, 0], on[ranked, 1]])
+    codes = (keys[:, 0] * 1000 + keys[:, 1] + 1) * 10 + keys[:, 2] + 1  # one integer per (generic, k, pulse)
+    _, first_seen = np.unique(codes, return_index=True)
+    firsts = {tuple(int(v) for v in keys[j]): int(ranked[j]) for j in np.sort(first_seen)}  # in ranked order
     chosen = [firsts[key] for key in sorted(firsts, key=lambda key: (key[0], score[firsts[key]]))]
-    order = chosen + [i for i in ranked if i not in set(chosen)]
-    for i in order[:max(limit - len(starts), 0)]:
+    wanted = max(limit - len(starts), 0)
+    taken = set(chosen)
+    order = chosen + [int(i) for i in ranked[:wanted + len(chosen)] if int(i) not in taken]
+    for i in order[:wanted]:
         prior = _Prior(expected[on[i, 0]], int(on[i, 1])) if on[i, 0] >= 0 else None
         starts.append((theta[i].copy(), prior))
     return starts[:limit]
