@@ -116,6 +116,44 @@ def test_a_firmness_map_follows_hertz_scaling():
     assert heights == pytest.approx(expected, rel=1e-7)
 
 
+def test_a_risk_map_drops_a_lot_at_every_point():
+    """Issue 14 item 4: the map's incidence is the share of a lot drawn from the fruit's library spreads.
+    Checks, each against something the map does not compute itself: (a) the same fruit fall at every point and
+    each fruit's stress rises with its speed (Hertz: p0 ∝ V^(2/5)), so a column's incidence never falls with
+    height; (b) a point's incidence is exactly that of a line audit of one transfer point at that height and
+    surface with the same lot (seed, size, spreads: the same draws through ``impact.lots``); (c) a lot of
+    identical fruit (no spreads) is bruised all or nothing, switching between the two grid heights around the
+    typical fruit's safe height; (d) the 50 % height lies between the two grid heights around the point where the
+    incidence crosses 1/2."""
+    import fruitimpact as fi
+    from fruitimpact.handling.heights import risk_map
+    from fruitimpact.handling.line import TransferPoint
+
+    risk = risk_map(by="surface", fruit="apple", criterion="shear", rows=100, seed=3)
+    heights = np.asarray(risk["heights"])
+    assert risk["lot"]["rows"] == 100 and risk["lot"]["seed"] == 3 and risk["lot"]["spreads"]
+    for column in risk["columns"]:
+        incidence = np.array([row["incidence"] for row in risk["rows"] if row["surface"] == column])
+        assert np.all(np.diff(incidence) >= 0.0), column  # (a)
+        above = int(np.flatnonzero(incidence >= 0.5)[0])
+        h50 = risk["incidence_heights"][column]["50%"]
+        assert (above == 0 and h50 <= heights[0]) or heights[above - 1] <= h50 <= heights[above]  # (d)
+    k = 12  # (b): one grid point, steel
+    point = next(row for row in risk["rows"] if row["surface"] == "steel" and row["drop_height"] == heights[k])
+    audit = fi.audit_line([TransferPoint("p", float(heights[k]), "steel")], rows=100, seed=3, fruit="apple", criterion="shear", alternatives=())
+    assert 0.0 < point["incidence"] < 1.0
+    assert point["incidence"] == audit["points"][0]["incidence"]
+    same = risk_map(by="surface", fruit="apple", criterion="shear", rows=50, spreads=False)  # (c)
+    for column in same["columns"]:
+        incidence = np.array([row["incidence"] for row in same["rows"] if row["surface"] == column])
+        assert set(np.unique(incidence)) <= {0.0, 1.0}
+        safe = same["safe_height"][column]
+        if math.isfinite(safe) and heights[0] < safe < heights[-1]:
+            assert np.all(incidence[heights < safe] == 0.0) and np.all(incidence[heights > safe] == 1.0), column
+    none = risk_map(by="surface", fruit="apple", criterion="shear", rows=0)
+    assert "lot" not in none and "incidence" not in none["rows"][0]
+
+
 def test_safe_height_edges_are_said():
     never = safe_height(criterion="energy", bruise_energy=100.0, sensitivity=False)
     assert never["safe_height"] == math.inf and "no bruise up to" in never["message"]

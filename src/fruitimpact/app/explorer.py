@@ -140,8 +140,9 @@ def _bounces(drop, inputs: dict) -> dict:
 
 
 def risk(request) -> dict:
-    """The risk map of the explorer's fruit: bruise margin over drop height × library surface, and the safe
-    height on each surface (``handling.heights.risk_map``)."""
+    """The risk map of the explorer's fruit: the share of a lot (the fruit's library spreads, ``MAP_FRUIT``
+    fruit) bruised over drop height × library surface, the typical fruit's margin and its safe height on each
+    surface (``handling.heights.risk_map``)."""
     from fruitimpact.handling.heights import risk_map
 
     inputs = _without_impact(read_request(request))
@@ -152,6 +153,11 @@ def risk(request) -> dict:
     return {"heights": [float(h) for h in mapped["heights"]], "columns": list(mapped["columns"]),
             "margins": [[_number(row["bruise_margin"]) for row in mapped["rows"] if row["surface"] == column]
                         for column in mapped["columns"]],
+            "incidence": [[_number(row["incidence"]) for row in mapped["rows"] if row["surface"] == column]
+                          for column in mapped["columns"]],
+            "incidence_heights": {column: {share: _number(h) for share, h in shares.items()}
+                                  for column, shares in mapped["incidence_heights"].items()},
+            "lot": {"rows": mapped["lot"]["rows"], "spreads": list(mapped["lot"]["spreads"])},
             "safe_height": {key: _number(value) for key, value in mapped["safe_height"].items()},
             "warnings": list(mapped["warnings"])}
 

@@ -67,17 +67,28 @@ def cmd_safe_height(args) -> int:
     check_outputs(("--map-csv", args.map_csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
     if (args.map_csv or args.plot) and not args.map:
         args.map = "surface"
+    for option, value in (("--map-fruit", args.map_fruit), ("--map-seed", args.map_seed),
+                          ("--no-spreads", args.no_spreads or None)):
+        if value is not None and not args.map:
+            raise UsageError(f"argument {option}: applies to the risk map: give --map surface or --map firmness")
     risk = None
     if args.map:  # first: its arguments are answered before either search runs
-        from fruitimpact.handling.heights import MAP_AXES, risk_map
+        from fruitimpact.handling.heights import MAP_AXES, MAP_FRUIT, risk_map
 
         # the map spans every value of its axis; the value given is the safe height's, below
-        risk = _library_call(risk_map, by=args.map, **{k: v for k, v in kwargs.items() if k != MAP_AXES[args.map]})
+        lot = {"rows": args.map_fruit if args.map_fruit is not None else MAP_FRUIT,
+               "seed": args.map_seed if args.map_seed is not None else 0, "spreads": not args.no_spreads}
+        risk = _library_call(risk_map, by=args.map, **lot,
+                             **{k: v for k, v in kwargs.items() if k != MAP_AXES[args.map]})
     report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
     if risk is not None:
         key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows",
                                                                      "safe_height"))
         report["risk_map"] = {"by": key, "safe_height": safe}
+        if "lot" in risk:
+            report["risk_map"].update(incidence_heights=risk["incidence_heights"], lot=risk["lot"])
+            if risk["lot"]["spreads"] and not args.json:  # (in the JSON: risk_map.lot.spreads)
+                print_spreads("safe-height", risk["lot"]["spreads"])
         # the map's warnings say on how many grid points: one the safe height already gave is not said twice
         given = report["warnings"]
         report["warnings"] += [text for text in risk["warnings"]
@@ -114,9 +125,18 @@ def cmd_safe_height(args) -> int:
         for name, value in report.get("sensitivity", {}).items():
             print(f"  d ln h / d ln {name} = {value:.4g}")
         if args.map:
-            print(f"safe height by {report['risk_map']['by']}:")
-            for column, value in report["risk_map"]["safe_height"].items():
-                print(f"  {column:>14}  {'inf' if math.isinf(value) else f'{value * 100:.4g} cm'}")
+            mapped = report["risk_map"]
+            shares = mapped.get("incidence_heights", {})
+            lot = mapped.get("lot")
+            print(f"safe height by {mapped['by']} (the typical fruit)"
+                  + (f"; the drop heights at which 10 % and 50 % of a lot of {lot['rows']} bruise:" if lot else ":"))
+
+            def cm(value):
+                return "inf" if math.isinf(value) else "< 5 mm" if value == 0.0 else f"{value * 100:.4g} cm"
+
+            for column, value in mapped["safe_height"].items():
+                extra = "".join(f"  {share}: {cm(height):>8}" for share, height in shares.get(column, {}).items())
+                print(f"  {column:>14}  {cm(value):>8}{extra}")
         for what, path in (("risk map", args.map_csv), ("figure", args.plot)):
             if path:
                 print(f"{what} written to {path}")
@@ -236,6 +256,7 @@ def lot_inputs(args) -> dict:
 
 def add_parsers(sub) -> None:
     from fruitimpact.handling.drops import BOUNCE_RULES, MAX_IMPACTS
+    from fruitimpact.handling.heights import MAP_FRUIT
 
     dr = sub.add_parser("drop", help="drop a fruit from a height: the rebounds until it rests, damage per impact",
                         description="Drop a fruit from --drop-height onto a surface; every impact at its own "
@@ -259,6 +280,11 @@ def add_parsers(sub) -> None:
                                                                    "or height × modulus")
     sh.add_argument("--map-csv", metavar="FILE", help="write the risk map as CSV")
     sh.add_argument("--plot", metavar="FILE", help="draw the risk map (PNG/SVG/PDF)")
+    sh.add_argument("--map-fruit", default=None, metavar="N",
+                    help=f"fruit of the lot dropped at every point of the map, for its incidence (default {MAP_FRUIT}; "
+                         f"0: the typical fruit only)")
+    sh.add_argument("--map-seed", default=None, metavar="S", help="random seed of the map's lot (default 0)")
+    add_spread_option(sh)
     sh.add_argument("--json", action="store_true", help="print one JSON object (SI)")
     sh.set_defaults(func=cmd_safe_height)
 

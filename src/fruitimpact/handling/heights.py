@@ -241,6 +241,12 @@ __all__ = ["HIGHEST", "LOWEST", "SENSITIVITY_INPUTS", "safe_height", "safe_heigh
 
 #: Rows of a risk map: heights [m] from 5 mm to 2 m, log-spaced.
 MAP_HEIGHTS = 30
+#: Fruit of a risk map's lot by default, and at most (each is dropped at every grid point: 30 heights × up to
+#: 10 columns).
+MAP_FRUIT = 200
+MAX_MAP_FRUIT = 20_000
+#: The shares of a lot whose drop heights a risk map reports per column.
+MAP_SHARES = (0.1, 0.5)
 #: Moduli of a firmness map [Pa].
 MAP_MODULI = (1e6, 1.5e6, 2e6, 2.5e6, 3e6, 4e6, 5e6, 6e6, 8e6, 10e6)
 #: What a risk map can run across (the ``--map`` choices) → the input it varies.
@@ -251,7 +257,7 @@ AXIS_INPUTS = {"surface": ("surface", "surface_model", "surface_modulus", "surfa
                "modulus": ("modulus", "stiffness")}
 
 
-def risk_map(*, by: str = "surface", **inputs) -> dict:
+def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, spreads: bool = True, **inputs) -> dict:
     """A bruise-risk map: drop height × library surface, or drop height × fruit modulus, with the safe
     height of each column, from one evaluation of the whole grid and one root search.
 
@@ -260,17 +266,32 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     by : str
         ``"surface"`` (every library surface but the rigid plane) or ``"firmness"`` (the fruit modulus over
         ``MAP_MODULI``, 1–10 MPa).
+    rows : int
+        Fruit of the lot dropped at every grid point (default ``MAP_FRUIT``, 200; at most ``MAX_MAP_FRUIT``;
+        0: none, the typical fruit only).  The lot is drawn once, reproducibly (``seed``), as ``population``
+        and a line audit draw it: the inputs given are fixed, and unless ``spreads`` is False the fruit's
+        library spreads are drawn for the inputs not given (issue 14 item 4).  The same fruit fall at every point, so a point's incidence never falls with height where
+        each fruit's stress rises with its speed.
+    seed : int
+        Seed of the lot's draws (≥ 0).
+    spreads : bool
+        Draw the fruit's library spreads for the inputs not given (default); False: a lot of identical fruit.
     **inputs
         As for :func:`safe_height` (fruit, model, criterion, …; not the velocity, drop height or the
-        mapped input).
+        mapped input), as numbers: each is fixed for the whole lot.
 
     Returns
     -------
     dict
         ``by`` (the input varied: ``surface`` or ``modulus``), ``columns`` (surface names or moduli [Pa]), ``heights`` (``MAP_HEIGHTS`` drop heights
         [m], 5 mm to 2 m, log-spaced), ``rows`` (one dict per grid point: the mapped value,
-        ``drop_height``, ``bruise_margin``, ``bruised``, ``bruise_volume`` [m³], ``peak_force`` [N],
-        ``status``) and ``safe_height`` (column → safe height [m]).
+        ``drop_height``; the typical fruit's ``bruise_margin``, ``bruised``, ``bruise_volume`` [m³],
+        ``peak_force`` [N] and ``status``; with a lot, ``incidence`` (the share of the lot bruised there) and
+        ``mean_bruise_volume`` [m³] over the lot), ``safe_height`` (column → the typical fruit's safe height
+        [m]) and, with a lot, ``incidence_heights`` (column → {"10%": h, "50%": h}: the drop height at which
+        that share of the lot bruises [m], interpolated in ln h between grid heights; inf beyond 2 m) and
+        ``lot`` (``rows``, ``seed``, ``inputs``: each drawn input's distribution, ``spreads``: the library
+        spreads used, as text).
 
     Raises
     ------
@@ -288,13 +309,20 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     As :func:`safe_height`.
     """
     from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.impact.lots import MAX_SEED, read_lot
     from fruitimpact.impact.registries import SURFACE_CHOICES
-    from fruitimpact.impact.validation import InputError
+    from fruitimpact.impact.validation import InputError, check_flag, read_count
 
     if by not in MAP_AXES:
         raise InputError(f"by must be one of {', '.join(MAP_AXES)}; got {by!r}", "map")
     key = MAP_AXES[by]
+    fruit = read_count("rows", rows, 0, MAX_MAP_FRUIT)
+    seed = read_count("seed", seed, 0, MAX_SEED)
+    spreads = check_flag("spreads", spreads)
     base, _ = _checked_inputs(inputs, "the risk map spans", axis=AXIS_INPUTS[key])
+    lot = read_lot(inputs, rows=fruit, seed=seed, spreads=spreads, criterion=base["criterion"],
+                   excluded=("velocity", "drop_height", *AXIS_INPUTS[key]),
+                   excluded_reason="is what the risk map spans: leave it out") if fruit else None
     heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
     columns = [name for name in SURFACE_CHOICES if name != "rigid"] if key == "surface" else list(MAP_MODULI)
     by = key
@@ -312,6 +340,61 @@ def risk_map(*, by: str = "surface", **inputs) -> dict:
     safe_table = {name: [value] * len(columns) for name, value in base.items()}
     safe_table[by] = columns
     safe, _ = safe_heights(safe_table, len(columns))
-    return {"by": by, "columns": columns, "heights": heights, "rows": rows,
-            "warnings": _merged_warnings(result, "grid points"),
-            "safe_height": {str(c): float(h) for c, h in zip(columns, safe)}}
+    report = {"by": by, "columns": columns, "heights": heights, "rows": rows,
+              "warnings": _merged_warnings(result, "grid points"),
+              "safe_height": {str(c): float(h) for c, h in zip(columns, safe)}}
+    if fruit:
+        report.update(_lot_incidence(lot, by, columns, heights, rows, base["criterion"]))
+        report["warnings"] += report.pop("warnings_lot")
+    return report
+
+
+def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: str) -> dict:
+    """Drop the lot (``(source, constants, described)`` of ``impact.lots.read_lot``) at every grid point: each
+    point's ``incidence`` and ``mean_bruise_volume`` into ``grid_rows``, and the heights of 10 % and 50 %
+    incidence per column (the ``risk_map`` keys)."""
+    from fruitimpact.impact.evaluation import evaluation
+    from fruitimpact.impact.lots import lot_details
+
+    source, constants, described = lot
+    fruit = source.rows
+    members, _ = source.inputs(0, fruit, None)
+    tiled = {name: np.tile(values, heights.size) for name, values in members.items()}
+    drop = np.repeat(heights, fruit)
+    warnings, crossing = [], {}
+    for c, column in enumerate(columns):
+        result = evaluation({**tiled, **constants, "criterion": criterion, by: column, "drop_height": drop})
+        ok = (result.status == 0).reshape(heights.size, fruit)
+        bruised = np.where(ok, np.nan_to_num(result.columns["bruised"]).reshape(heights.size, fruit), 0.0) > 0.5
+        volume = np.where(bruised, result.columns["bruise_volume"].reshape(heights.size, fruit), 0.0)
+        counted = ok.sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):  # a point where no fruit was computed: unknown
+            incidence = np.where(counted > 0, bruised.sum(axis=1) / counted, np.nan)
+            mean_volume = np.where(counted > 0, volume.sum(axis=1) / counted, np.nan)
+        for h in range(heights.size):
+            grid_rows[c * heights.size + h].update(incidence=float(incidence[h]),
+                                                   mean_bruise_volume=float(mean_volume[h]))
+        if not ok.all():
+            warnings.append(f"{column}: {int((~ok).sum())} of {ok.size} fruit-drops not computed (the first: "
+                            f"{result.messages.text(int(np.flatnonzero(~ok.ravel())[0]))}); the shares are of the "
+                            f"others")
+        crossing[str(column)] = {f"{share:.0%}": _height_of_share(heights, incidence, share)
+                                 for share in MAP_SHARES}
+    return {"incidence_heights": crossing, "warnings_lot": warnings,
+            "lot": {"rows": fruit, **lot_details(source, described)}}
+
+
+def _height_of_share(heights: np.ndarray, incidence: np.ndarray, share: float) -> float:
+    """The lowest drop height [m] at which ``incidence`` reaches ``share``, interpolated in ln h between the
+    grid heights around it; 0 below the lowest, inf when it is not reached by the highest (NaN points skipped)."""
+    known = np.isfinite(incidence)
+    h, f = heights[known], incidence[known]
+    above = np.flatnonzero(f >= share)
+    if not above.size:
+        return math.inf
+    k = int(above[0])
+    if k == 0:
+        return 0.0 if f[0] > share else float(h[0])
+    lo, hi = f[k - 1], f[k]
+    t = (share - lo) / (hi - lo)
+    return float(math.exp(math.log(h[k - 1]) + t * (math.log(h[k]) - math.log(h[k - 1]))))

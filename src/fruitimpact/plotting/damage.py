@@ -10,20 +10,27 @@ from fruitimpact.plotting._backend import _pyplot
 
 
 def risk_map_figure(key: str, columns, heights, rows, safe: dict, criterion: str):
-    """Bruise margin over drop height (x, log) and surface or modulus (y), with each column's safe
-    height marked; ``rows`` as from ``handling.heights.risk_map`` (column-major: all heights of the first
-    column first)."""
+    """Over drop height (x, log) and surface or modulus (y): the share of the lot bruised where the map dropped a
+    lot (``incidence``), else the typical fruit's bruise margin; each column's safe height (the typical fruit)
+    marked.  ``rows`` as from ``handling.heights.risk_map`` (column-major: all heights of the first column
+    first)."""
     plt = _pyplot()
-    margin = np.array([row["bruise_margin"] for row in rows], dtype=float).reshape(len(columns), len(heights))
+    lot = "incidence" in rows[0]
+    name = "incidence" if lot else "bruise_margin"
+    values = np.array([row[name] for row in rows], dtype=float).reshape(len(columns), len(heights))
     fig, ax = plt.subplots(figsize=(8, 0.45 * len(columns) + 2.2), constrained_layout=True)
-    limit = np.nanmax(np.abs(margin[np.isfinite(margin)])) if np.isfinite(margin).any() else 1.0
-    limit = min(max(limit, 1e-3), 5.0)
     labels = [str(c) if key == "surface" else f"{c / 1e6:g} MPa" for c in columns]
     logs = np.log(np.asarray(heights, dtype=float) * 100.0)
     edges = np.exp(np.concatenate(([1.5 * logs[0] - 0.5 * logs[1]], 0.5 * (logs[1:] + logs[:-1]),
                                    [1.5 * logs[-1] - 0.5 * logs[-2]])))
-    image = ax.pcolormesh(edges, np.arange(len(columns) + 1) - 0.5,
-                          np.clip(margin, -limit, limit), cmap="RdYlGn_r", vmin=-limit, vmax=limit)
+    if lot:
+        image = ax.pcolormesh(edges, np.arange(len(columns) + 1) - 0.5, values * 100.0, cmap="RdYlGn_r",
+                              vmin=0.0, vmax=100.0)
+    else:
+        limit = np.nanmax(np.abs(values[np.isfinite(values)])) if np.isfinite(values).any() else 1.0
+        limit = min(max(limit, 1e-3), 5.0)
+        image = ax.pcolormesh(edges, np.arange(len(columns) + 1) - 0.5, np.clip(values, -limit, limit),
+                              cmap="RdYlGn_r", vmin=-limit, vmax=limit)
     for j, column in enumerate(columns):
         height = safe.get(str(column), math.nan)
         if math.isfinite(height) and height > 0:
@@ -32,8 +39,13 @@ def risk_map_figure(key: str, columns, heights, rows, safe: dict, criterion: str
     ax.set_yticks(range(len(columns)), labels)
     ax.set_xlabel("drop height h [cm]")
     ax.set_ylabel("surface" if key == "surface" else "Young's modulus E")
-    ax.set_title(f"bruise risk, criterion {criterion}: margin (≥ 0 bruised); black: safe drop height")
-    fig.colorbar(image, ax=ax, label="bruise margin [-]")
+    if lot:
+        ax.set_title(f"bruise risk, criterion {criterion}: share of the lot bruised; black: the typical fruit's "
+                     f"safe drop height")
+        fig.colorbar(image, ax=ax, label="bruised fruit [%]")
+    else:
+        ax.set_title(f"bruise risk, criterion {criterion}: margin (≥ 0 bruised); black: safe drop height")
+        fig.colorbar(image, ax=ax, label="bruise margin [-]")
     return fig
 
 

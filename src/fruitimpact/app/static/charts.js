@@ -104,13 +104,17 @@ const Charts = (() => {
     const cw = W / cols, rh = H / rows;
     const color = (v) => {
       if (v === null || !Number.isFinite(v)) return "#f0f0f0";
+      if (spec.share) {  // a share: pale green at 0 to red at 1
+        const s = Math.max(0, Math.min(1, v));
+        return `rgb(${230 + 10 * s | 0},${240 - 210 * s | 0},${230 - 200 * s | 0})`;
+      }
       const t = Math.max(-1, Math.min(1, v));
       if (t >= 0) return `rgb(${200 + 40 * t | 0},${120 - 90 * t | 0},${110 - 80 * t | 0})`;
       return `rgb(${230 + 20 * t | 0},${240 + 5 * t | 0},${230 + 20 * t | 0})`;
     };
     spec.values.forEach((column, c) => column.forEach((v, r) => {
       el("rect", {x: f.left + c * cw, y: f.top + H - (r + 1) * rh, width: cw + 0.5, height: rh + 0.5, fill: color(v)}, svg)
-        .appendChild(document.createElementNS(NS, "title")).textContent = `${spec.columns[c]}, ${spec.rows[r]}: margin ${v === null ? "–" : v.toFixed(2)}`;
+        .appendChild(document.createElementNS(NS, "title")).textContent = `${spec.columns[c]}, ${spec.rows[r]}: ` + (spec.share ? `${v === null ? "–" : (100 * v).toFixed(1)} % bruised` : `margin ${v === null ? "–" : v.toFixed(2)}`);
     }));
     spec.columns.forEach((name, c) => {
       el("text", {x: f.left + (c + 0.5) * cw, y: f.top + H + 14, "text-anchor": "middle"}, svg).textContent = name;

@@ -204,8 +204,9 @@ async function risk() {
     const heights = body.heights, logs = heights.map(Math.log);
     const position = (h) => (Math.log(h) - logs[0]) / (logs[logs.length - 1] - logs[0]) * (heights.length - 1) + 0.5;
     const rowTicks = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2].filter((h) => h >= heights[0] && h <= heights[heights.length - 1]).map((h) => [position(h), lengthText(h)]);
-    Charts.heat(svg, {columns: body.columns, rows: heights.map(lengthText), values: body.margins,
-      safe: body.columns.map((c) => body.safe_height[c]), position, rowTicks, xLabel: "surface (— safe height)", yLabel: "drop height"});
+    Charts.heat(svg, {columns: body.columns, rows: heights.map(lengthText), values: body.incidence, share: true,
+      safe: body.columns.map((c) => body.safe_height[c]), position, rowTicks,
+      xLabel: `surface: share of ${body.lot.rows} fruit bruised (— safe height of the typical fruit)`, yLabel: "drop height"});
   } finally {
     button.disabled = false;
     button.textContent = "compute (height × surface)";
