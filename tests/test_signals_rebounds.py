@@ -390,6 +390,33 @@ def test_the_rebound_of_a_fruit_hidden_in_an_overlap_is_judged_against_the_lanes
     assert not late.rebound, late.evidence
 
 
+def test_the_bounce_of_a_rebound_hidden_in_an_overlap_is_a_rebound_of_the_overlap():
+    """A fruit's rebound lands together with the next fruit (one overlap, no pulse of its own): the fruit's next
+    bounce (the same m, K, c at e₂ e₁ V after the flight 2 e₂ e₁ V/g from the overlap) is a rebound of that
+    overlap (rebounds.hidden_rebound), not a new fruit; a new fruit at the line's speed landing at the same
+    moment is a new fruit; and the bounce is not mistaken for the rebound of the fruit hidden beside it, whose
+    flight is about 1/e₁ times longer (rebounds.judge_unmeasured scores it farther).  Margins: the prediction's
+    own spread (r = 0.92 e ± 10 %, the spot), as for a measured parent."""
+    from fruitimpact.signals.rebounds import hidden_rebound, judge_unmeasured
+
+    first = impact()
+    parent = summary(first, 0.1, 0, V_LINE)
+    landing = parent.separation + 2 * 0.95 * first["e"] * V_LINE / G  # its rebound lands, a little spin
+    virtual = hidden_rebound(parent, 7, landing)
+    assert virtual.velocity == pytest.approx(0.92 * first["e"] * V_LINE) and virtual.refined
+    speed = 0.95 * first["e"] * V_LINE  # the rebound's real speed
+    rebound = impact(c=first["c"], velocity=speed)
+    bounce = impact(c=first["c"], velocity=0.95 * rebound["e"] * speed)
+    when = landing + rebound["T"] + 2 * 0.95 * rebound["e"] * speed / G
+    verdict = judge(summary(bounce, when, 8), [parent.taken(), virtual], max_flight=1.0)
+    assert verdict.rebound and verdict.parent == 7, verdict.evidence
+    new = judge(summary(impact(mass=0.95 * MASS, restitution=0.58), when, 8), [parent.taken(), virtual],
+                max_flight=1.0)
+    assert not new.rebound, new.evidence
+    beside = judge_unmeasured(summary(bounce, when, 8), 7, landing, _lane_fruit(), V_LINE)
+    assert beside.evidence["score"] > verdict.evidence["score"], (beside.evidence, verdict.evidence)
+
+
 def test_without_the_lanes_fruit_or_speed_a_hidden_fruits_rebound_is_not_guessed():
     """Fewer than 5 measured fruit, or no line speed: nothing stands for the hidden fruit, so no decision."""
     from fruitimpact.signals.rebounds import NEW_FRUIT, judge_unmeasured

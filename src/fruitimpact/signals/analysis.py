@@ -42,8 +42,8 @@ from fruitimpact.impact.validation import InputError
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices, judge,
-                                         judge_unmeasured, rebounds_due, refine, shape_table)
+from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
+                                         hidden_rebound, judge, judge_unmeasured, rebounds_due, refine, shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -237,7 +237,7 @@ class LineAnalyzer:
                           time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
                           contact_duration=(impact.end_index + 1 - impact.start_index) / analysis.rate,
                           impulse=float(np.sum(inside)) / analysis.rate)
-        return [self._contact(own, report, shape, status, message)]
+        return [self._contact(own, report, shape, status, message, due if status == "overlap" else ())]
 
     def _split_further(self, parts, rebounds: list[bool], due: list[PulseSummary]):
         """The pieces of a split, one of them split again where it holds a third pulse: when more than one earlier
@@ -306,8 +306,11 @@ class LineAnalyzer:
                            fit))
         return pieces
 
-    def _contact(self, impact: DetectedImpact, report: dict, shape: dict | None, status: str, message: str) -> dict:
-        """The rest of a contact's report: the rebound decision, the fit restated, the class."""
+    def _contact(self, impact: DetectedImpact, report: dict, shape: dict | None, status: str, message: str,
+                 hidden: list[PulseSummary] | tuple = ()) -> dict:
+        """The rest of a contact's report: the rebound decision, the fit restated, the class.  ``hidden``: for an
+        overlap, the earlier contacts whose rebound was due in it (``rebounds_due``): their rebounds are taken to
+        have landed there (``rebounds.hidden_rebound``), so that each one's own rebound can be recognised."""
         analysis = self.analysis
         sequence = self._sequence.get(impact.lane, 0)
         self._sequence[impact.lane] = sequence + 1
@@ -333,9 +336,14 @@ class LineAnalyzer:
         report.update(rebound=rebound, rebound_of=verdict.parent if rebound else None,
                       rebound_ambiguous=bool(verdict is not None and verdict.ambiguous),
                       rebound_evidence=verdict.evidence if verdict is not None else None)
-        if summary is not None and not rebound and not report["rebound_ambiguous"]:
+        if summary is not None and not rebound:
+            # not a measured contact's rebound: perhaps that of a fruit hidden in an overlap.  Where both are
+            # ambiguous (a contact after an overlap that held a fruit and a rebound: the rebound's own bounce, or
+            # the hidden fruit's), the closer hypothesis is kept
             hidden = self._unmeasured_parent(impact.lane, summary)
-            if hidden.rebound or hidden.ambiguous:
+            closer = hidden.rebound or (hidden.ambiguous and (
+                not report["rebound_ambiguous"] or _score(hidden) < _score(verdict)))
+            if closer:
                 rebound = hidden.rebound
                 if rebound:  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
                     speed = None
@@ -358,6 +366,8 @@ class LineAnalyzer:
         if status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
+            history.extend(hidden_rebound(parent, sequence, report["start_time"]) for parent in hidden[:MAX_DUE]
+                           if parent.velocity is not None)
         elif summary is not None and not rebound and summary.refined:
             self._fruit.setdefault(impact.lane, []).append(summary)
             del self._fruit[impact.lane][:-LANE_FRUIT_KEPT]
@@ -530,6 +540,12 @@ def _merge_fit(report: dict, result: dict) -> None:
 def public(report: dict) -> dict:
     """The JSON object of a report: without its private entries (the whole fit)."""
     return {key: value for key, value in report.items() if not key.startswith("_")}
+
+
+def _score(verdict: Verdict) -> float:
+    """A verdict's score (its distance from the hypothesis, in tolerances; inf when it has none)."""
+    score = (verdict.evidence or {}).get("score")
+    return float(score) if score is not None else math.inf
 
 
 def _finite(value) -> bool:

@@ -57,7 +57,8 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "judge_unmeasured",
+__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
+           "judge_unmeasured",
            "rebounds_due", "refine", "shape_table"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
@@ -358,6 +359,28 @@ def expected_rebound(parent: PulseSummary) -> dict:
             "log_peak_sd": math.sqrt(spread[0] ** 2 + tol["spot"] ** 2 + parent.peak_force_sd ** 2),
             "log_duration_sd": math.sqrt(spread[1] ** 2 + tol["spot"] ** 2 + parent.time_to_peak_sd ** 2),
             "x_sd": math.sqrt(spread[2] ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2)}
+
+
+def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSummary:
+    """The summary of ``parent``'s rebound when it landed inside a contact that could not be measured (contact
+    ``sequence``, an overlap starting at ``onset`` [s], in which that rebound was due, ``rebounds_due``): the
+    same fruit at r V_p, r = ``EXPECTED_RATIO`` e_p, its pulse the one ``expected_rebound`` predicts and its
+    spreads those of the prediction.  Its own rebound, the fruit's next bounce at about r² V_p, is then judged
+    like any other (``judge``): without it, that bounce had no parent and was taken for a new fruit (or for the
+    rebound of the fruit hidden beside it, ``judge_unmeasured``)."""
+    guess = expected_rebound(parent)
+    r = EXPECTED_RATIO * parent.restitution
+    xr = guess["x"]
+    e_r = _at("e", xr)
+    de_dx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (xr * (1.05 - 1.0 / 1.05)) if xr > 0 else 0.0
+    impulse = parent.impulse * r * (1.0 + e_r) / (1.0 + parent.restitution)
+    tc = parent.time_to_peak * r ** -0.2 * _at("tc", xr) / _at("tc", parent.x)
+    return PulseSummary(sequence=sequence, onset=onset, separation=onset + math.exp(guess["log_duration"]),
+                        peak_force=math.exp(guess["log_peak"]), time_to_peak=tc, impulse=impulse, x=xr,
+                        restitution=e_r, peak_force_sd=guess["log_peak_sd"], time_to_peak_sd=guess["log_duration_sd"],
+                        impulse_sd=math.hypot(EXPECTED_RATIO_SD, parent.impulse_sd), x_sd=guess["x_sd"],
+                        restitution_sd=math.hypot(abs(de_dx) * guess["x_sd"], parent.restitution_sd),
+                        velocity=r * parent.velocity if parent.velocity is not None else None, refined=True)
 
 
 #: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 3 degrees of freedom
