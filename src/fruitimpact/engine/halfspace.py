@@ -43,6 +43,8 @@ import numba as nb
 from fruitimpact.engine.powerlaw import r_func
 
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
+#: Widest piece in λ = ln(v_b − v) of the plastic line's quadrature (e-folds; 24 nodes reach ~1e-13 over 6).
+LAMBDA_PIECE = 6.0
 
 
 @nb.njit(**_JIT)
@@ -58,6 +60,65 @@ def _work_unloading(mass, short, u, c):
     """U(u): the elastic energy still stored at the outward speed u = w − ``short`` [J]."""
     d = short / (1.0 - c * u)
     return mass * d * (d * r_func(-c * d) + u)
+
+
+@nb.njit(**_JIT)
+def _fall_for_work(mass, c, start, work):
+    """D ≥ 0: loading from the speed ``start``, F_T has done ``work`` [J] when the speed has fallen to start − D.
+
+    E(start) − E(start − D) = work with E(v) = m g(c v)/c², g(y) = y − ln(1 + y); in w = c D/(1 + c start) it is
+    c start w − w² r(−w) = c² work/m, concave and increasing in w: Newton from w = c² work/(m c start), below the
+    root, climbs to it monotonically.  D comes out directly, not as the difference of two speeds (which cancels
+    when the work is a sliver of the impact's energy)."""
+    if work <= 0.0:
+        return 0.0
+    if c == 0.0:
+        s = 2.0 * work / mass
+        return s / (start + math.sqrt(max(start * start - s, 0.0)))
+    a = c * start
+    q = c * c * work / mass
+    w = q / a
+    for _ in range(100):
+        g = a * w - w * w * r_func(-w) - q
+        slope = a - w / (1.0 - w)
+        if not slope > 0.0:
+            break
+        step = g / slope
+        w_new = min(w - step, 0.5 * (w + 1.0))  # inside (0, 1)
+        if abs(w_new - w) <= 1e-16 * w_new:
+            w = w_new
+            break
+        w = w_new
+    return w * (1.0 + a) / c
+
+
+@nb.njit(**_JIT)
+def _rise_for_work(mass, c, end, work):
+    """Δ ≥ 0: the speed end + Δ from which F_T still had ``work`` [J] to do before the speed fell to ``end``.
+
+    E(end + Δ) − E(end) = work; in z = c Δ/(1 + c end) it is c end z + z² r(z) = c² work/m, convex and increasing:
+    Newton from an upper bound descends to the root monotonically."""
+    if work <= 0.0:
+        return 0.0
+    if c == 0.0:
+        s = 2.0 * work / mass
+        return s / (end + math.sqrt(end * end + s))
+    b = c * end
+    q = c * c * work / mass
+    z = q + math.sqrt(q * q + 2.0 * q)  # z² r(z) ≥ z²/(2(1 + z)) reaches q there
+    if b > 0.0:
+        z = min(z, q / b)
+    for _ in range(100):
+        f = b * z + z * z * r_func(z) - q
+        slope = b + z / (1.0 + z)
+        z_new = z - f / slope
+        if not z_new > 0.0:
+            z_new = 0.5 * z
+        if abs(z_new - z) <= 1e-16 * z_new:
+            z = z_new
+            break
+        z = z_new
+    return z * (1.0 + b) / c
 
 
 @nb.njit(**_JIT)
@@ -192,22 +253,30 @@ def _time_from_touch(mass, velocity, c, K04, FY, KP, WY, depth, nodes, weights):
 
 
 @nb.njit(**_JIT)
-def _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_branch, v_low, v_high, nodes, weights):
+def _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_yield, delta, v_low, v_high, nodes, weights):
     """Time on the plastic piece while the speed falls from ``v_high`` (≤ v_y) to ``v_low`` [s].
 
-    F² = F_y² + 2 π p_y R (W(v) − W_y) = 2 π p_y R (W(v) − W(v_b)) vanishes at a speed v_b just above v_y when
-    F_y ≪ F* (the line's root beyond its yield end), so F = √(v_b − v) × (analytic): in λ = ln(v_b − v) the
-    integrand is analytic and Gauss–Legendre converges geometrically however close v_b lies to v_y.  Below
-    v_high/2 (away from v_b) plain Gauss–Legendre in v, as in ``_time_from_touch``."""
+    F² = F_y² + 2 π p_y R W(v_y → v) vanishes at v_b = v_y + ``delta`` just above v_y when F_y ≪ F* (the line
+    continued back), so F = √(v_b − v) × (analytic): in λ = ln(v_b − v) the integrand is analytic and
+    Gauss–Legendre converges geometrically however close v_b lies to v_y.  The work since the yield point is the
+    module's identity from v_y (not W(v) − W_y, which cancels next to it), and v_b − v = ρ is the node itself.
+    Below v_high/2 (away from v_b) plain Gauss–Legendre in v, as in ``_time_from_touch``."""
     split = max(v_low, 0.5 * v_high)
-    lam_low = math.log(v_branch - v_high)
-    width = math.log(v_branch - split) - lam_low
+    lam_start = math.log(delta + (v_yield - v_high))
+    lam_end = math.log(delta + (v_yield - split))
+    # pieces of at most LAMBDA_PIECE in λ: the integrand's analytic strip has a fixed width in λ, so a range of
+    # many e-folds (v_b just above v_y, a fruit far beyond its yield speed) needs more nodes, not finer ones
+    pieces = max(1, int(math.ceil((lam_end - lam_start) / LAMBDA_PIECE)))
+    width = (lam_end - lam_start) / pieces
     total = 0.0
-    for j in range(nodes.shape[0]):
-        rho = math.exp(lam_low + width * 0.5 * (nodes[j] + 1.0))
-        v = v_branch - rho
-        F = _force_loading(_work_loading(mass, velocity - v, v, c), K04, FY, KP, WY)
-        total += 0.5 * weights[j] * width * rho * mass / (F * (1.0 + c * v))
+    for k in range(pieces):
+        lam_low = lam_start + k * width
+        for j in range(nodes.shape[0]):
+            rho = math.exp(lam_low + width * 0.5 * (nodes[j] + 1.0))
+            fall = max(rho - delta, 0.0)  # v_y − v
+            v = v_yield - fall
+            F = math.sqrt(FY * FY + 2.0 * KP * _work_loading(mass, fall, v, c))
+            total += 0.5 * weights[j] * width * rho * mass / (F * (1.0 + c * v))
     if split > v_low:
         total += _time_uniform(mass, velocity, c, K04, FY, KP, WY, v_low, split, nodes, weights)
     return total
@@ -236,25 +305,29 @@ def _unloading_time(mass, exit_speed, c, KU04, nodes, weights):
 
 
 @nb.njit(**_JIT)
-def halfspace_impact(mass, velocity, c, K, FY, DY, KP, KU, R, yield_pressure, F_star, v_yield, v_branch,
-                     exit_speed, nodes, weights):
+def halfspace_impact(mass, velocity, c, K, FY, DY, KP, KU, R, yield_pressure, F_star, exit_speed, nodes, weights):
     """(peak force [N], peak centre pressure [Pa], time to peak [s], time to the largest deflection [s],
     unloading time [s]) of one damped Thornton impact on a half-space.
 
     ``K`` Hertz stiffness [N/m^1.5], ``FY``/``DY`` yield force [N] and deflection [m] (inf: elastic), ``KP`` =
     π p_y R [N/m], ``KU`` the unloading stiffness (4/3) E* √R_p [N/m^1.5], ``F_star`` the largest F_T [N],
-    ``v_yield`` the speed left when F_T reaches F_y (0 when it does not) [m/s], ``v_branch`` the speed v_b > v_y
-    where the plastic line, continued back, reaches F = 0 (``_time_plastic``) [m/s], ``exit_speed`` w [m/s]."""
+    ``exit_speed`` w [m/s]."""
     WY = 0.4 * FY * DY if FY < math.inf else math.inf
     K04 = K ** 0.4
+    if F_star > FY:  # it yields: the Hertz piece ends at the speed v_y, the plastic line's root lies δ above it
+        depth = _fall_for_work(mass, c, velocity, WY)
+        v_yield = velocity - depth
+        delta = _rise_for_work(mass, c, v_yield, 0.5 * FY * FY / KP)
+    else:
+        depth, v_yield, delta = velocity, 0.0, 0.0
     if c > 0.0:
         peak, v_peak = _largest(mass, velocity, c, K, K04, FY, KP, WY, v_yield, F_star, R, yield_pressure, False)
         pressure, _ = _largest(mass, velocity, c, K, K04, FY, KP, WY, v_yield, F_star, R, yield_pressure, True)
     else:
         peak, v_peak = F_star, 0.0
         pressure = _pressure_loading(F_star, K, FY, R, yield_pressure)
-    hertz = _time_from_touch(mass, velocity, c, K04, FY, KP, WY, velocity - v_yield, nodes, weights)
-    plastic = _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_branch, 0.0, v_yield, nodes, weights) \
+    hertz = _time_from_touch(mass, velocity, c, K04, FY, KP, WY, depth, nodes, weights)
+    plastic = _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_yield, delta, 0.0, v_yield, nodes, weights) \
         if v_yield > 0.0 else 0.0
     time_to_max = hertz + plastic
     if v_peak <= 0.0:
@@ -262,7 +335,8 @@ def halfspace_impact(mass, velocity, c, K, FY, DY, KP, KU, R, yield_pressure, F_
     elif v_peak >= v_yield:  # the peak is on the Hertz piece
         time_to_peak = _time_from_touch(mass, velocity, c, K04, FY, KP, WY, velocity - v_peak, nodes, weights)
     else:
-        time_to_peak = hertz + _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_branch, v_peak, v_yield, nodes, weights)
+        time_to_peak = hertz + _time_plastic(mass, velocity, c, K04, FY, KP, WY, v_yield, delta, v_peak, v_yield,
+                                             nodes, weights)
     unload = _unloading_time(mass, exit_speed, c, KU ** 0.4, nodes, weights) if exit_speed > 0.0 else 0.0
     return peak, pressure, time_to_peak, time_to_max, unload
 

@@ -522,15 +522,9 @@ def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressu
 
     if not layer_stiffness < math.inf and c * exit_speed < HALFSPACE_DAMPING_LIMIT:
         # a half-space: every work inverts in closed form, walk in the speed
-        v_yield, v_branch = 0.0, 0.0
-        if F_star > p[FY_]:
-            W_y = load_work(p[FY_], p)
-            v_yield = speed_of_energy(mass, c, energy - W_y)
-            # the plastic line F² = F_y² + 2 kp (W − W_y) continued back to F = 0, at W_y − F_y²/(2 kp) > 0
-            v_branch = speed_of_energy(mass, c, energy - W_y + 0.5 * p[FY_] * p[FY_] / p[KP_])
         peak, pressure, time_to_peak, time_to_max, unload_time = halfspace_impact(
-            mass, velocity, c, stiffness, p[FY_], p[DY_], p[KP_], p[KU_], radius, yield_pressure, F_star, v_yield,
-            v_branch, exit_speed, nodes, weights)
+            mass, velocity, c, stiffness, p[FY_], p[DY_], p[KP_], p[KU_], radius, yield_pressure, F_star,
+            exit_speed, nodes, weights)
     else:
         peak, pressure, time_to_peak, time_to_max, unload_time = _layered_impact(
             mass, c, energy, returned, p, F_star, yield_pressure, nodes, weights)
