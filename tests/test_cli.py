@@ -692,3 +692,28 @@ def test_simulate_from_the_console_starts_no_numba(tmp_path):
 
     assert imported("0") == []
     assert imported("1")
+
+
+@pytest.mark.parametrize("extra,option", [
+    (["--map-fruit", "-1"], "--map-fruit"), (["--map-fruit", "1e9"], "--map-fruit"), (["--map-fruit", "abc"], "--map-fruit"),
+    (["--map-seed", "-3"], "--map-seed"), (["--map-seed", "1.5"], "--map-seed"),
+    (["--map-fruit", "0", "--no-spreads"], "--no-spreads"), (["--map-fruit", "0", "--map-seed", "4"], "--map-seed")])
+def test_the_risk_maps_lot_options_are_refused_by_their_own_names(cli, extra, option):
+    """The map's lot options answer bad values with one line naming the option (not the library's rows/seed),
+    and options that would do nothing (a seed or --no-spreads for a map without a lot) are refused, not ignored."""
+    status, out, err = cli.run("safe-height", "--fruit", "apple", "--criterion", "shear", "--map", "surface",
+                               "--no-sensitivity", *extra)
+    assert status == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"fruitimpact safe-height: error: argument {option}:"), err
+
+
+def test_the_risk_map_spans_its_axis_whatever_the_command_gives_for_it(cli):
+    """--modulus (or a surface and its properties) given with the map of that axis is the safe height's; the map
+    spans every column alike, modulus and stiffness, surface and surface modulus (they were treated apart)."""
+    report = cli.json("safe-height", "--fruit", "apple", "--criterion", "shear", "--map", "surface", "--no-sensitivity",
+                      "--surface-modulus", "1e9", "--map-fruit", "20")
+    plain = cli.json("safe-height", "--fruit", "apple", "--criterion", "shear", "--map", "surface", "--no-sensitivity",
+                     "--map-fruit", "20")
+    assert report["risk_map"]["safe_height"] == plain["risk_map"]["safe_height"]
+    assert report["risk_map"]["incidence_heights"] == plain["risk_map"]["incidence_heights"]
+    assert report["risk_map"]["lot"]["rows"] == 20

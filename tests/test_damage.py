@@ -122,8 +122,9 @@ def test_a_risk_map_drops_a_lot_at_every_point():
     each fruit's stress rises with its speed (Hertz: p0 ∝ V^(2/5)), so a column's incidence never falls with
     height; (b) a point's incidence is exactly that of a line audit of one transfer point at that height and
     surface with the same lot (seed, size, spreads: the same draws through ``impact.lots``); (c) a lot of
-    identical fruit (no spreads) is bruised all or nothing, switching between the two grid heights around the
-    typical fruit's safe height; (d) the 50 % height lies between the two grid heights around the point where the
+    identical fruit (no spreads) is bruised all or nothing, switching at the typical fruit's safe height, which is
+    then also its 10 % and 50 % heights; (d) the 50 % height (an order statistic of the fruit's own safe heights,
+    a root search independent of the grid's evaluations) lies between the two grid heights where the grid's
     incidence crosses 1/2."""
     import fruitimpact as fi
     from fruitimpact.handling.heights import risk_map
@@ -137,7 +138,7 @@ def test_a_risk_map_drops_a_lot_at_every_point():
         assert np.all(np.diff(incidence) >= 0.0), column  # (a)
         above = int(np.flatnonzero(incidence >= 0.5)[0])
         h50 = risk["incidence_heights"][column]["50%"]
-        assert (above == 0 and h50 <= heights[0]) or heights[above - 1] <= h50 <= heights[above]  # (d)
+        assert (above == 0 and h50 <= heights[0]) or heights[above - 1] <= h50 <= heights[above], column  # (d)
     k = 12  # (b): one grid point, steel
     point = next(row for row in risk["rows"] if row["surface"] == "steel" and row["drop_height"] == heights[k])
     audit = fi.audit_line([TransferPoint("p", float(heights[k]), "steel")], rows=100, seed=3, fruit="apple", criterion="shear", alternatives=())
@@ -150,8 +151,11 @@ def test_a_risk_map_drops_a_lot_at_every_point():
         safe = same["safe_height"][column]
         if math.isfinite(safe) and heights[0] < safe < heights[-1]:
             assert np.all(incidence[heights < safe] == 0.0) and np.all(incidence[heights > safe] == 1.0), column
+        assert same["incidence_heights"][column] == {"10%": safe, "50%": safe}
     none = risk_map(by="surface", fruit="apple", criterion="shear", rows=0)
     assert "lot" not in none and "incidence" not in none["rows"][0]
+    firm = risk_map(by="firmness", fruit="apple", criterion="shear", rows=20)  # the axis is not drawn
+    assert "modulus" not in firm["lot"]["inputs"] and "mass" in firm["lot"]["inputs"]
 
 
 def test_safe_height_edges_are_said():

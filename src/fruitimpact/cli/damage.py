@@ -6,7 +6,7 @@ import math
 import sys
 
 from fruitimpact.cli.common import (PROG, UsageError, _add_impact_options, _library_call, _simulate_kwargs,
-                                    add_spread_option, check_outputs, dump_json, print_spreads)
+                                    add_spread_option, check_outputs, dump_json, print_spreads, read_option_count)
 from fruitimpact.impact.outputs import CSV_FORMAT, FIGURE_FORMATS
 from fruitimpact.impact.quantities import INPUTS, OUTPUTS
 
@@ -73,13 +73,20 @@ def cmd_safe_height(args) -> int:
             raise UsageError(f"argument {option}: applies to the risk map: give --map surface or --map firmness")
     risk = None
     if args.map:  # first: its arguments are answered before either search runs
-        from fruitimpact.handling.heights import MAP_AXES, MAP_FRUIT, risk_map
+        from fruitimpact.handling.heights import AXIS_INPUTS, MAP_AXES, MAP_FRUIT, MAX_MAP_FRUIT, risk_map
+        from fruitimpact.impact.lots import MAX_SEED
 
-        # the map spans every value of its axis; the value given is the safe height's, below
-        lot = {"rows": args.map_fruit if args.map_fruit is not None else MAP_FRUIT,
-               "seed": args.map_seed if args.map_seed is not None else 0, "spreads": not args.no_spreads}
-        risk = _library_call(risk_map, by=args.map, **lot,
-                             **{k: v for k, v in kwargs.items() if k != MAP_AXES[args.map]})
+        fruit = read_option_count("--map-fruit", args.map_fruit if args.map_fruit is not None else MAP_FRUIT, 0,
+                                  MAX_MAP_FRUIT)
+        seed = read_option_count("--map-seed", args.map_seed if args.map_seed is not None else 0, 0, MAX_SEED)
+        for option, value in (("--map-seed", args.map_seed), ("--no-spreads", args.no_spreads or None)):
+            if value is not None and fruit == 0:
+                raise UsageError(f"argument {option}: applies to the map's lot, and --map-fruit 0 draws none")
+        # the map spans every value of its axis: what the command gives for it (the modulus, or the surface and
+        # its properties) is the safe height's, below, and each column's own value is the map's
+        axis = AXIS_INPUTS[MAP_AXES[args.map]]
+        risk = _library_call(risk_map, by=args.map, rows=fruit, seed=seed, spreads=not args.no_spreads,
+                             **{k: v for k, v in kwargs.items() if k not in axis})
     report = _library_call(safe_height, sensitivity=not args.no_sensitivity, **kwargs)
     if risk is not None:
         key, columns, heights, rows, safe = (risk[name] for name in ("by", "columns", "heights", "rows",
@@ -132,7 +139,8 @@ def cmd_safe_height(args) -> int:
                   + (f"; the drop heights at which 10 % and 50 % of a lot of {lot['rows']} bruise:" if lot else ":"))
 
             def cm(value):
-                return "inf" if math.isinf(value) else "< 5 mm" if value == 0.0 else f"{value * 100:.4g} cm"
+                return ("inf" if math.isinf(value) else "any" if value == 0.0 else "unknown" if math.isnan(value)
+                        else f"{value * 100:.4g} cm")
 
             for column, value in mapped["safe_height"].items():
                 extra = "".join(f"  {share}: {cm(height):>8}" for share, height in shares.get(column, {}).items())

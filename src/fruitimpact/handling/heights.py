@@ -47,6 +47,21 @@ def _margins(table: dict, heights: np.ndarray):
         return np.log1p(np.maximum(margin, -1.0)), result
 
 
+def _rows_of(table: dict, index: np.ndarray, rows: int) -> dict:
+    """The rows ``index`` of ``table`` (a column ``rows`` long is cut, a constant kept)."""
+    if index.size == rows:
+        return table
+    cut = {}
+    for name, value in table.items():
+        if isinstance(value, np.ndarray) and value.ndim == 1 and value.shape[0] == rows:
+            cut[name] = value[index]
+        elif isinstance(value, (list, tuple)) and len(value) == rows:
+            cut[name] = [value[i] for i in index]
+        else:
+            cut[name] = value
+    return cut
+
+
 def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
     """Safe drop height [m] of every row of ``table`` (columns of inputs, ``rows`` long, with a
     ``criterion``; no velocity or drop height), and a message per row ("ok", or why not).
@@ -91,12 +106,20 @@ def safe_heights(table: dict, rows: int) -> tuple[np.ndarray, list]:
         previous = np.where(active & ~bad, x, np.nan)
         if not active.any():
             break
-        f_x, step = _margins(table, np.exp(x))
+        # only the rows still searching are evaluated (rows are independent: the same numbers, fewer impacts)
+        searching = np.flatnonzero(active)
+        f_searching, step = _margins(_rows_of(table, searching, rows), np.exp(x[searching]))
+        f_x = np.full(rows, np.nan)
+        f_x[searching] = f_searching
+        failed = np.zeros(rows, dtype=bool)
+        failed[searching] = (step.status != 0) | np.isnan(f_searching)
+        where = np.full(rows, -1)
+        where[searching] = np.arange(searching.size)
         # a row whose evaluation inside the bracket failed has no margin there: it is not a root, and its NaN
         # must not count as "no bruise" (that narrowed the bracket onto a wrong height reported as ok)
-        lost = active & ((step.status != 0) | np.isnan(f_x))
+        lost = active & failed
         for i in np.flatnonzero(lost):
-            text = step.messages.text(i)
+            text = step.messages.text(int(where[i]))
             messages[i] = (f"the search failed at h = {math.exp(x[i]):.4g} m: "
                            f"{text if text and text != 'ok' else 'no bruise margin there'}")
             low[i] = high[i] = math.nan
@@ -288,8 +311,9 @@ def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, sprea
         ``drop_height``; the typical fruit's ``bruise_margin``, ``bruised``, ``bruise_volume`` [m³],
         ``peak_force`` [N] and ``status``; with a lot, ``incidence`` (the share of the lot bruised there) and
         ``mean_bruise_volume`` [m³] over the lot), ``safe_height`` (column → the typical fruit's safe height
-        [m]) and, with a lot, ``incidence_heights`` (column → {"10%": h, "50%": h}: the drop height at which
-        that share of the lot bruises [m], interpolated in ln h between grid heights; inf beyond 2 m) and
+        [m]) and, with a lot, ``incidence_heights`` (column → {"10%": h, "50%": h}: the drop height above which
+        that share of the lot bruises [m], the order statistic of each fruit's own safe height; inf: not up to
+        10 m; NaN: unknown) and
         ``lot`` (``rows``, ``seed``, ``inputs``: each drawn input's distribution, ``spreads``: the library
         spreads used, as text).
 
@@ -321,7 +345,7 @@ def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, sprea
     spreads = check_flag("spreads", spreads)
     base, _ = _checked_inputs(inputs, "the risk map spans", axis=AXIS_INPUTS[key])
     lot = read_lot(inputs, rows=fruit, seed=seed, spreads=spreads, criterion=base["criterion"],
-                   excluded=("velocity", "drop_height", *AXIS_INPUTS[key]),
+                   excluded=("velocity", "drop_height", *AXIS_INPUTS[key]), fixed=AXIS_INPUTS[key],
                    excluded_reason="is what the risk map spans: leave it out") if fruit else None
     heights = np.geomspace(5e-3, 2.0, MAP_HEIGHTS)
     columns = [name for name in SURFACE_CHOICES if name != "rigid"] if key == "surface" else list(MAP_MODULI)
@@ -351,8 +375,9 @@ def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, sprea
 
 def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: str) -> dict:
     """Drop the lot (``(source, constants, described)`` of ``impact.lots.read_lot``) at every grid point: each
-    point's ``incidence`` and ``mean_bruise_volume`` into ``grid_rows``, and the heights of 10 % and 50 %
-    incidence per column (the ``risk_map`` keys)."""
+    point's ``incidence`` and ``mean_bruise_volume`` into ``grid_rows``; per column the drop heights at which
+    ``MAP_SHARES`` of the lot bruise, as order statistics of each fruit's own safe height (exact, not
+    interpolated between grid heights); the ``risk_map`` keys."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.lots import lot_details
 
@@ -362,6 +387,12 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
     tiled = {name: np.tile(values, heights.size) for name, values in members.items()}
     drop = np.repeat(heights, fruit)
     warnings, crossing = [], {}
+    # each fruit's own safe height on every column, in one root search over them all (each iteration is one
+    # evaluation of the whole table)
+    onsets_all, _ = safe_heights({**{name: np.tile(values, len(columns)) for name, values in members.items()},
+                                  **constants, "criterion": criterion, by: [column for column in columns
+                                                                            for _ in range(fruit)]},
+                                 fruit * len(columns))
     for c, column in enumerate(columns):
         result = evaluation({**tiled, **constants, "criterion": criterion, by: column, "drop_height": drop})
         ok = (result.status == 0).reshape(heights.size, fruit)
@@ -378,23 +409,21 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
             warnings.append(f"{column}: {int((~ok).sum())} of {ok.size} fruit-drops not computed (the first: "
                             f"{result.messages.text(int(np.flatnonzero(~ok.ravel())[0]))}); the shares are of the "
                             f"others")
-        crossing[str(column)] = {f"{share:.0%}": _height_of_share(heights, incidence, share)
-                                 for share in MAP_SHARES}
+        onsets = onsets_all[c * fruit:(c + 1) * fruit]
+        crossing[str(column)] = {f"{share:.0%}": _height_of_share(onsets, share) for share in MAP_SHARES}
+        missing = int(np.isnan(onsets).sum())
+        if missing:
+            warnings.append(f"{column}: the safe height of {missing} of {fruit} fruit was not found; the heights "
+                            f"of {' and '.join(f'{share:.0%}' for share in MAP_SHARES)} incidence are of the others")
     return {"incidence_heights": crossing, "warnings_lot": warnings,
             "lot": {"rows": fruit, **lot_details(source, described)}}
 
 
-def _height_of_share(heights: np.ndarray, incidence: np.ndarray, share: float) -> float:
-    """The lowest drop height [m] at which ``incidence`` reaches ``share``, interpolated in ln h between the
-    grid heights around it; 0 below the lowest, inf when it is not reached by the highest (NaN points skipped)."""
-    known = np.isfinite(incidence)
-    h, f = heights[known], incidence[known]
-    above = np.flatnonzero(f >= share)
-    if not above.size:
-        return math.inf
-    k = int(above[0])
-    if k == 0:
-        return 0.0 if f[0] > share else float(h[0])
-    lo, hi = f[k - 1], f[k]
-    t = (share - lo) / (hi - lo)
-    return float(math.exp(math.log(h[k - 1]) + t * (math.log(h[k]) - math.log(h[k - 1]))))
+def _height_of_share(onsets: np.ndarray, share: float) -> float:
+    """The drop height [m] above which ``share`` of the lot bruises: the order statistic k = ⌈share × n⌉ of the
+    fruit's own safe heights ``onsets`` (NaN ones left out: their search failed); inf: that share does not
+    bruise up to 10 m; NaN: no fruit's safe height was found."""
+    known = np.sort(onsets[~np.isnan(onsets)])
+    if not known.size:
+        return math.nan
+    return float(known[max(int(math.ceil(share * known.size)) - 1, 0)])

@@ -106,7 +106,7 @@ class PopulationSource:
 
 
 def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: str | None = None,
-             excluded=(), excluded_reason: str = ""):
+             excluded=(), excluded_reason: str = "", fixed=()):
     """(source, text inputs, lines describing the library spreads) of a lot of ``rows`` fruit, from ``inputs``
     (input → a constant ``0.115``/``"115g"``, a distribution text ``"normal(115g,10g)"``, or a name for the text
     inputs), as ``population`` and a line audit both take them.
@@ -115,7 +115,8 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     says why), a text input not in its registry, a distribution that cannot be read, two alternatives given
     together, a constant out of its range or one the others need (``impact.evaluation.refuse_constants``).  The
     inputs not given are drawn from the fruit's library spreads unless ``spreads`` is False (the bruise inputs
-    only with a ``criterion``).  ``InputError`` naming the input otherwise."""
+    only with a ``criterion``), except those of ``fixed`` (each evaluation of the lot sets them: a risk map's
+    axis).  ``InputError`` naming the input otherwise."""
     from fruitimpact.impact.distributions import Constant, parse_distribution
     from fruitimpact.impact.evaluation import refuse_constants
     from fruitimpact.impact.presets import lot_distributions
@@ -144,7 +145,7 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     given = [name for name, _ in distributions] + list(text)
     check_conflicts(given)
     refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
-    extra, density, described = lot_distributions(text.get("fruit"), [name for name, _ in distributions],
+    extra, density, described = lot_distributions(text.get("fruit"), [name for name, _ in distributions] + list(fixed),
                                                   criterion, spreads=spreads)
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
     return source, text, tuple(described)
