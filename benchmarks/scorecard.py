@@ -26,6 +26,7 @@ The analysis run is whatever ``fruitimpact`` the current interpreter imports (PY
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import subprocess
@@ -149,6 +150,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="the tests' small sizes (~20-40 contacts)")
     parser.add_argument("--markdown", metavar="FILE", help="also write the scorecard as Markdown")
     parser.add_argument("--scenarios", metavar="NAMES", help="comma-separated scenarios (default: all)")
+    parser.add_argument("--seed", type=int, default=None, metavar="N",
+                        help="generate every scenario with this seed instead of its own (other lines of the same kind)")
     args = parser.parse_args(argv)
     names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
     unknown = [n for n in names if n not in lg.SCENARIOS]
@@ -159,6 +162,8 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
         for name in names:
             scenario = lg.SCENARIOS[name]
+            if args.seed is not None:
+                scenario = dataclasses.replace(scenario, seed=args.seed)
             size = scenario.quick_size if args.quick else scenario.size
             card = run_scenario(scenario, size, Path(folder))
             cards.append(card)

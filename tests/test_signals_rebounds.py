@@ -383,9 +383,18 @@ def test_the_rebound_of_a_fruit_hidden_in_an_overlap_is_judged_against_the_lanes
     flight = 2 * 0.95 * hidden["e"] * V_LINE / G  # a little spin
     verdict = judge_unmeasured(summary(back, left + flight, 99), 42, 1.0, fruit, V_LINE)
     assert verdict.rebound and verdict.parent == 42, verdict.evidence
+    assert verdict.evidence["rebound_distance"] < verdict.evidence["new_fruit_distance"]
     new = judge_unmeasured(summary(impact(mass=0.95 * MASS, restitution=0.58), left + flight, 99), 42, 1.0, fruit,
                            V_LINE)
     assert not new.rebound, new.evidence
+    # a light, lively new fruit landing when the rebound is due (mass 0.77 of the lane's, e 0.66): each of the
+    # rebound's loose tests passes it (score 0.94 ≤ 1), but a new fruit of the lane fits its restitution and
+    # impulse better (distance 2.8 against 3.2 sd): a new fruit, said to be ambiguous, with the evidence
+    lively = judge_unmeasured(summary(impact(mass=0.77 * MASS, restitution=0.66), left + flight, 99), 42, 1.0,
+                              fruit, V_LINE)
+    assert lively.evidence["score"] <= 1.0
+    assert lively.evidence["new_fruit_distance"] < lively.evidence["rebound_distance"]
+    assert not lively.rebound and lively.ambiguous
     late = judge_unmeasured(summary(back, left + 2 * flight, 99), 42, 1.0, fruit, V_LINE)
     assert not late.rebound, late.evidence
 
@@ -397,10 +406,13 @@ def test_the_bounce_of_a_rebound_hidden_in_an_overlap_is_a_rebound_of_the_overla
     moment is a new fruit; and the bounce is not mistaken for the rebound of the fruit hidden beside it, whose
     flight is about 1/e₁ times longer (rebounds.judge_unmeasured scores it farther).  Margins: the prediction's
     own spread (r = 0.92 e ± 10 %, the spot), as for a measured parent."""
-    from fruitimpact.signals.rebounds import hidden_rebound, judge_unmeasured
+    from fruitimpact.signals.rebounds import hidden_rebound, judge_unmeasured, likeliest_hidden
 
     first = impact()
     parent = summary(first, 0.1, 0, V_LINE)
+    early = summary(impact(), 0.0, 5, V_LINE)  # due too (rebounds_due is wide), but predicted 0.1 s off
+    landing0 = parent.separation + 2 * 0.92 * first["e"] * V_LINE / G
+    assert likeliest_hidden([early, parent], landing0) is parent  # one hidden rebound per overlap: the best timed
     landing = parent.separation + 2 * 0.95 * first["e"] * V_LINE / G  # its rebound lands, a little spin
     virtual = hidden_rebound(parent, 7, landing)
     assert virtual.velocity == pytest.approx(0.92 * first["e"] * V_LINE) and virtual.refined

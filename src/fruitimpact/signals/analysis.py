@@ -43,7 +43,8 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
-                                         hidden_rebound, judge, judge_unmeasured, rebounds_due, refine, shape_table)
+                                         hidden_rebound, judge, judge_unmeasured, likeliest_hidden, rebounds_due,
+                                         refine, shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -326,29 +327,30 @@ class LineAnalyzer:
         if summary is not None and analysis.flight_limit > 0:
             verdict = judge(summary, history, max_flight=analysis.flight_limit,
                             last_fruit_onset=self._last_fruit.get(impact.lane), pitch=analysis.pitch)
-        rebound = verdict is not None and verdict.rebound
+        chosen, hidden_fruit = verdict, False
+        judged = verdict is not None and (verdict.rebound or verdict.ambiguous)
+        if summary is not None and (not judged or verdict.ambiguous):
+            # not clearly a measured (or predicted) contact's rebound: perhaps that of a fruit hidden in an overlap.
+            # Where both hypotheses are near (a contact after an overlap that held a fruit and a rebound: the
+            # rebound's own bounce, or the hidden fruit's), the closer one is kept
+            hidden = self._unmeasured_parent(impact.lane, summary)
+            if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
+                chosen, hidden_fruit = hidden, True
+        rebound = chosen is not None and chosen.rebound
         speed = analysis.velocity
-        if rebound:
-            index = next(i for i, s in enumerate(history) if s.sequence == verdict.parent)
+        if rebound and hidden_fruit:  # a hidden fruit rebounds once
+            self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
+            speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
+        elif rebound:
+            index = next(i for i, s in enumerate(history) if s.sequence == chosen.parent)
             parent = history[index]
             history[index] = parent.taken()
-            speed = verdict.speed_ratio * parent.velocity if parent.velocity is not None else None
-        report.update(rebound=rebound, rebound_of=verdict.parent if rebound else None,
-                      rebound_ambiguous=bool(verdict is not None and verdict.ambiguous),
-                      rebound_evidence=verdict.evidence if verdict is not None else None)
-        if summary is not None and not rebound:
-            # not a measured contact's rebound: perhaps that of a fruit hidden in an overlap.  Where both are
-            # ambiguous (a contact after an overlap that held a fruit and a rebound: the rebound's own bounce, or
-            # the hidden fruit's), the closer hypothesis is kept
-            hidden = self._unmeasured_parent(impact.lane, summary)
-            closer = hidden.rebound or (hidden.ambiguous and (
-                not report["rebound_ambiguous"] or _score(hidden) < _score(verdict)))
-            if closer:
-                rebound = hidden.rebound
-                if rebound:  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
-                    speed = None
-                report.update(rebound=rebound, rebound_of=hidden.parent, rebound_ambiguous=hidden.ambiguous,
-                              rebound_evidence=hidden.evidence)
+            # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
+            speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
+                else None
+        report.update(rebound=rebound, rebound_of=chosen.parent if rebound else None,
+                      rebound_ambiguous=bool(chosen is not None and chosen.ambiguous),
+                      rebound_evidence=chosen.evidence if chosen is not None else None)
         if analysis.fit and shape is not None and status != "overlap":
             result = _restated(shape, analysis, speed)
             _merge_fit(report, result)
@@ -366,8 +368,9 @@ class LineAnalyzer:
         if status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
-            history.extend(hidden_rebound(parent, sequence, report["start_time"]) for parent in hidden[:MAX_DUE]
-                           if parent.velocity is not None)
+            likeliest = likeliest_hidden(list(hidden), report["start_time"])
+            if likeliest is not None:  # at most one rebound hides in an overlap: the one due nearest its onset
+                history.append(hidden_rebound(likeliest, sequence, report["start_time"]))
         elif summary is not None and not rebound and summary.refined:
             self._fruit.setdefault(impact.lane, []).append(summary)
             del self._fruit[impact.lane][:-LANE_FRUIT_KEPT]
@@ -384,18 +387,16 @@ class LineAnalyzer:
 
     def _unmeasured_parent(self, lane: int, summary: PulseSummary) -> Verdict:
         """The verdict on a contact that no measured contact claims as its rebound: the rebound of a fruit hidden
-        in an earlier overlap of the lane (``rebounds.judge_unmeasured``), or a new fruit."""
+        in an earlier overlap of the lane (``rebounds.judge_unmeasured``), or a new fruit.  The caller removes the
+        overlap's entry when it takes the verdict (a hidden fruit rebounds once)."""
         limit = self.analysis.flight_limit
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
         fruit = self._fruit.get(lane, [])
         verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.analysis.velocity)
                     for sequence, onset, _ in reversed(recent)]
-        verdict = min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
-                      else math.inf, default=NEW_FRUIT)
-        if verdict.rebound:  # a hidden fruit rebounds once
-            self._unmeasured[lane] = [u for u in self._unmeasured[lane] if u[0] != verdict.parent]
-        return verdict
+        return min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
+                   else math.inf, default=NEW_FRUIT)
 
 
 #: Rate [Hz] of the warm-up's synthetic contacts.  What it prepares (the pulse tables, numba's compiled code) is

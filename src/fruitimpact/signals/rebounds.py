@@ -58,6 +58,7 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
+           "likeliest_hidden",
            "judge_unmeasured",
            "rebounds_due", "refine", "shape_table"]
 
@@ -154,6 +155,8 @@ class PulseSummary:
     velocity: float | None = None
     rebound_taken: bool = False
     refined: bool = False
+    #: a rebound that landed inside an overlap, as predicted (``hidden_rebound``), not measured
+    virtual: bool = False
 
     def with_velocity(self, velocity: float | None) -> PulseSummary:
         return replace(self, velocity=velocity)
@@ -253,7 +256,8 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
         / (z * math.sqrt(candidate.x_sd ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2) + 1e-12),
     }
     flight = candidate.onset - parent.separation
-    evidence = {"parent": parent.sequence, "flight_observed": flight, "flight_predicted": None,
+    evidence = {"parent": parent.sequence, **({"virtual_parent": True} if parent.virtual else {}),
+                "flight_observed": flight, "flight_predicted": None,
                 "peak_observed": candidate.peak_force, "peak_predicted": peak_pred, "speed_ratio": r,
                 "restitution_parent": parent.restitution}
     if parent.velocity is not None:
@@ -361,6 +365,15 @@ def expected_rebound(parent: PulseSummary) -> dict:
             "x_sd": math.sqrt(spread[2] ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2)}
 
 
+def likeliest_hidden(due: list[PulseSummary], onset: float) -> PulseSummary | None:
+    """Of the contacts whose rebound was due in an overlap starting at ``onset`` [s], the one whose rebound was
+    predicted to land nearest it (in units of its flight): an overlap holds at most one hidden rebound."""
+    timed = [(abs(onset - (p.separation + 2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY))
+              / (2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY), p)
+             for p in due if p.velocity is not None and p.velocity > 0 and p.restitution > 0]
+    return min(timed, key=lambda item: item[0])[1] if timed else None
+
+
 def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSummary:
     """The summary of ``parent``'s rebound when it landed inside a contact that could not be measured (contact
     ``sequence``, an overlap starting at ``onset`` [s], in which that rebound was due, ``rebounds_due``): the
@@ -380,7 +393,8 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
                         restitution=e_r, peak_force_sd=guess["log_peak_sd"], time_to_peak_sd=guess["log_duration_sd"],
                         impulse_sd=math.hypot(EXPECTED_RATIO_SD, parent.impulse_sd), x_sd=guess["x_sd"],
                         restitution_sd=math.hypot(abs(de_dx) * guess["x_sd"], parent.restitution_sd),
-                        velocity=r * parent.velocity if parent.velocity is not None else None, refined=True)
+                        velocity=r * parent.velocity if parent.velocity is not None else None, refined=True,
+                        virtual=True)
 
 
 #: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 3 degrees of freedom
@@ -457,6 +471,19 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
                           f"measured; its fruit's rebound, judged from the lane's {len(fruit)} measured fruit"}
     rebound = score <= 1.0
     ambiguous = AMBIGUOUS[0] < score <= AMBIGUOUS[1]
+    # the other explanation: a new fruit of the lane at the line's speed (its restitution and impulse those of
+    # the lane's fruit, within their spread).  Each test above is loose (a rebound's impulse, r (1 + e_r)/(1 + e)
+    # ≈ 0.65 of a fruit's, lies within the lane's 3 sd of mass), so on the two tests both hypotheses share the
+    # rebound must fit better than a new fruit does; otherwise the contact is a new fruit, said to be ambiguous
+    e_lane_sd = math.hypot(max(_robust_sd([f.restitution for f in fruit]), 1e-3), candidate.restitution_sd)
+    new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
+        (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2
+    rebound2 = (deviations["restitution"] * z) ** 2 + (deviations["impulse"] * z) ** 2
+    evidence["new_fruit_distance"] = round(math.sqrt(new_fruit2), 3)
+    evidence["rebound_distance"] = round(math.sqrt(rebound2), 3) if math.isfinite(rebound2) else None
+    if rebound and not rebound2 < new_fruit2:
+        rebound, ambiguous = False, True
+        evidence["reason"] += "; but a new fruit of the lane fits its restitution and impulse as well or better"
     if not rebound and not ambiguous:
         return NEW_FRUIT
     return Verdict(rebound, hidden if rebound else None, ambiguous, r if rebound else None, evidence)
