@@ -180,9 +180,12 @@ async function show(index) {
   for (const tr of document.querySelectorAll("#impacts tbody tr.selected")) tr.classList.remove("selected");
   const tr = document.querySelector(`#impacts tbody tr[data-index="${index}"]`);
   if (tr) tr.classList.add("selected");
-  const answer = await post("/api/impact", {analysis: last.analysis, index});
+  const analysis = last.analysis;
+  const answer = await post("/api/impact", {analysis, index});
+  // a newer analysis, or another click, since the request: its answer is not this view's (an answer for the same
+  // index of the analysis before was shown with the new table: another impact's numbers)
+  if (selected !== index || !last || last.analysis !== analysis) return;
   if (answer.refused) { document.getElementById("impact-caption").textContent = answer.error; return; }
-  if (selected !== index) return;
   const row = answer.row;
   const series = [{x: answer.time, y: answer.force, color: "#5b6775", label: "samples"}];
   if (answer.model) series.push({x: answer.model.time, y: answer.model.force, color: "#b3261e", label: "fitted model"});
