@@ -370,6 +370,10 @@ def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, sprea
     if fruit:
         report.update(_lot_incidence(lot, by, columns, heights, rows, base["criterion"]))
         report["warnings"] += report.pop("warnings_lot")
+        # the lot's own warnings that the typical fruit's grid did not already give (a spread fruit's, e.g. one
+        # that leaves Hertz's range where the typical one does not)
+        report["warnings"] += [line for text, line in report.pop("noted_lot").items()
+                               if not any(known.startswith(text + " (") for known in report["warnings"])]
     return report
 
 
@@ -387,6 +391,7 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
     tiled = {name: np.tile(values, heights.size) for name, values in members.items()}
     drop = np.repeat(heights, fruit)
     warnings, crossing = [], {}
+    noted: dict[str, int] = {}  # the lot's own warnings (inputs, impacts) → fruit-drops carrying them
     # each fruit's own safe height on every column, in one root search over them all (each iteration is one
     # evaluation of the whole table)
     onsets_all, _ = safe_heights({**{name: np.tile(values, len(columns)) for name, values in members.items()},
@@ -405,6 +410,8 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
         for h in range(heights.size):
             grid_rows[c * heights.size + h].update(incidence=float(incidence[h]),
                                                    mean_bruise_volume=float(mean_volume[h]))
+        for bit, text in enumerate(result.warnings.texts):
+            noted[text] = noted.get(text, 0) + int(np.count_nonzero(result.warnings.masks >> bit & 1))
         if not ok.all():
             warnings.append(f"{column}: {int((~ok).sum())} of {ok.size} fruit-drops not computed (the first: "
                             f"{result.messages.text(int(np.flatnonzero(~ok.ravel())[0]))}); the shares are of the "
@@ -415,7 +422,9 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
         if missing:
             warnings.append(f"{column}: the safe height of {missing} of {fruit} fruit was not found; the heights "
                             f"of {' and '.join(f'{share:.0%}' for share in MAP_SHARES)} incidence are of the others")
-    return {"incidence_heights": crossing, "warnings_lot": warnings,
+    drops = fruit * heights.size * len(columns)
+    lot_noted = {text: f"{text} ({count} of {drops} fruit-drops of the lot)" for text, count in noted.items()}
+    return {"incidence_heights": crossing, "warnings_lot": warnings, "noted_lot": lot_noted,
             "lot": {"rows": fruit, **lot_details(source, described)}}
 
 
