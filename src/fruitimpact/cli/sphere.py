@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import sys
 
-from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json, print_spreads
+from fruitimpact.cli.common import PROG, _library_call, check_outputs, dump_json, print_spreads
 from fruitimpact.impact.outputs import FIGURE_FORMATS
 
 #: The sphere's own options: (dest, option, metavar, help).  Values are read by the library (units accepted).

@@ -473,7 +473,6 @@ def _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, l
     guess = stiffness ** 0.4 * (2.5 * energy) ** 0.6
     F_star = _solve_max_force(energy, p, guess)
     df_star = _fruit_load(F_star, p)[0]
-    dl_star = _layer(F_star, p)[0]
     if F_star > p[FY_]:
         FY = p[FY_]
         radius_p = 4.0 * contact_modulus / (3.0 * F_star) * ((2.0 * F_star + FY) / (2.0 * math.pi * yield_pressure)) ** 1.5

@@ -368,20 +368,19 @@ def risk_map(*, by: str = "surface", rows: int = MAP_FRUIT, seed: int = 0, sprea
               "warnings": _merged_warnings(result, "grid points"),
               "safe_height": {str(c): float(h) for c, h in zip(columns, safe)}}
     if fruit:
-        report.update(_lot_incidence(lot, by, columns, heights, rows, base["criterion"]))
-        report["warnings"] += report.pop("warnings_lot")
-        # the lot's own warnings that the typical fruit's grid did not already give (a spread fruit's, e.g. one
-        # that leaves Hertz's range where the typical one does not)
-        report["warnings"] += [line for text, line in report.pop("noted_lot").items()
-                               if not any(known.startswith(text + " (") for known in report["warnings"])]
+        figures, warnings = _lot_incidence(lot, by, columns, heights, rows, base["criterion"], report["warnings"])
+        report.update(figures)
+        report["warnings"] += warnings
     return report
 
 
-def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: str) -> dict:
+def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: str, known: list) -> tuple[dict, list]:
     """Drop the lot (``(source, constants, described)`` of ``impact.lots.read_lot``) at every grid point: each
     point's ``incidence`` and ``mean_bruise_volume`` into ``grid_rows``; per column the drop heights at which
     ``MAP_SHARES`` of the lot bruise, as order statistics of each fruit's own safe height (exact, not
-    interpolated between grid heights); the ``risk_map`` keys."""
+    interpolated between grid heights): (the ``risk_map`` keys, the lot's warnings).  Of the lot's evaluations'
+    own warnings only those not ``known`` already (the typical fruit's grid) are said: a spread fruit's, e.g. one
+    that leaves Hertz's range where the typical one does not."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.lots import lot_details
 
@@ -423,9 +422,9 @@ def _lot_incidence(lot, by: str, columns, heights, grid_rows: list, criterion: s
             warnings.append(f"{column}: the safe height of {missing} of {fruit} fruit was not found; the heights "
                             f"of {' and '.join(f'{share:.0%}' for share in MAP_SHARES)} incidence are of the others")
     drops = fruit * heights.size * len(columns)
-    lot_noted = {text: f"{text} ({count} of {drops} fruit-drops of the lot)" for text, count in noted.items()}
-    return {"incidence_heights": crossing, "warnings_lot": warnings, "noted_lot": lot_noted,
-            "lot": {"rows": fruit, **lot_details(source, described)}}
+    warnings += [f"{text} ({count} of {drops} fruit-drops of the lot)" for text, count in noted.items()
+                 if not any(line.startswith(text + " (") for line in known)]
+    return {"incidence_heights": crossing, "lot": {"rows": fruit, **lot_details(source, described)}}, warnings
 
 
 def _height_of_share(onsets: np.ndarray, share: float) -> float:

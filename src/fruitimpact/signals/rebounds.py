@@ -368,10 +368,12 @@ def expected_rebound(parent: PulseSummary) -> dict:
 def likeliest_hidden(due: list[PulseSummary], onset: float) -> PulseSummary | None:
     """Of the contacts whose rebound was due in an overlap starting at ``onset`` [s], the one whose rebound was
     predicted to land nearest it (in units of its flight): an overlap holds at most one hidden rebound."""
-    timed = [(abs(onset - (p.separation + 2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY))
-              / (2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY), p)
-             for p in due if p.velocity is not None and p.velocity > 0 and p.restitution > 0]
-    return min(timed, key=lambda item: item[0])[1] if timed else None
+    def miss(p: PulseSummary) -> float:  # how far its predicted landing lies from the onset, in flights
+        flight = 2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY
+        return abs(onset - (p.separation + flight)) / flight
+
+    timed = [p for p in due if p.velocity is not None and p.velocity > 0 and p.restitution > 0]
+    return min(timed, key=miss, default=None)
 
 
 def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSummary:

@@ -279,7 +279,7 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
     def row(shape_index, onset_index):
         return shape_index * n_o + onset_index
 
-    # the pairs, in the order of the loops they replace: (row A, row B, duration A, duration B, x A, x B,
+    # the pairs of unit pulses, one per row of ``table``, in the order of the loops they replace: (row A, row B, duration A, duration B, x A, x B,
     # expected k or −1, the pulse it is, B's onset sample); A starts with the contact
     blocks = []
     at_g, da_g, db_g = np.meshgrid(np.arange(n_g), generic, generic, indexing="ij")  # at, duration A, duration B
@@ -303,7 +303,6 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
         pairs_k[0::2], pairs_k[1::2] = fruit_first, rebound_first
         blocks.append(pairs_k)
     table = np.concatenate(blocks)
-    pairs = table  # (its length is what the rest reads)
     a, b = table[:, 0].astype(int), table[:, 1].astype(int)
     # row by row (einsum's own loops: a BLAS product this small would wake BLAS's threads, which then spin
     # beside the stream on a small machine)
@@ -320,12 +319,12 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
         floor = max(level, MIN_SHARE * float(y[top]))
         good = (det > 1e-12 * aa * bb) & (peak_a > floor) & (peak_b > floor)
         log_a, log_b = np.log(np.where(good, peak_a, 1.0)), np.log(np.where(good, peak_b, 1.0))
-    theta = np.column_stack([np.full(len(pairs), ts[first]), log_a, np.log(table[:, 2]), table[:, 4],
+    theta = np.column_stack([np.full(len(table), ts[first]), log_a, np.log(table[:, 2]), table[:, 4],
                              ts[table[:, 8].astype(int)], log_b, np.log(table[:, 3]), table[:, 5]])
-    prior_chi2 = np.zeros(len(pairs))
-    on = np.full((len(pairs), 2), -1)  # (expected k, pulse) of each pair's prior
+    prior_chi2 = np.zeros(len(table))
+    on = np.full((len(table), 2), -1)  # (expected k, pulse) of each pair's prior
     if expected:
-        best = np.full(len(pairs), np.inf)
+        best = np.full(len(table), np.inf)
         for k, guess in enumerate(expected):
             for pulse in (0, 1):
                 value = sum(((theta[:, 4 * pulse + 1 + i] - guess[key]) / guess[f"{key}_sd"]) ** 2

@@ -272,7 +272,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         warnings.append(f"{bad} of {len(readings)} readings reproduced by no impact (the first, row "
                         f"{int(readings.rows[first])}: {result.message[first]}); left out of the points' figures")
     summaries = []
-    for k, name in enumerate(groups.names):
+    for k in range(len(groups.names)):
         members = np.flatnonzero((groups.point == k) & ok)
         if members.size == 0:
             summaries.append(None)

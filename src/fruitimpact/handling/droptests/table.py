@@ -218,7 +218,7 @@ class _Implausible:
 
     def warnings(self, rows: int) -> list:
         out = []
-        for column, ((where, text), count) in self.seen.items():
+        for (where, text), count in self.seen.values():
             more = f"; {count} of {rows} rows are" if count > 1 else ""
             out.append(f"{text} ({where}{more})")
         return out
