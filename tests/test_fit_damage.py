@@ -841,6 +841,25 @@ def test_absurd_values_give_one_line_each_and_no_numerical_noise(tmp_path, scrip
     assert "no usable test: every row was refused" in err and "energy: its impact speed" in err
 
 
+def test_an_absurd_mass_or_diameter_skips_its_row_not_the_table(tmp_path, script):
+    """A review found a 1e300 m diameter ending in an OverflowError traceback (its sphere volume) and a 1e200 kg
+    mass refusing the whole table with an internal message ("threshold_energy must be … got inf"): values 100
+    times beyond the plausible range for fruit are no fruit impact, so their row is refused, naming the row and the
+    column, and the others are fitted; a legal but implausible mass (168 kg, grams typed without their unit) stays
+    a warning, as for every input."""
+    data = drop_tests(41, per_height=3)
+    rows = [[h, "steel", m, 0.075, v] for h, m, v in zip(data["drop_height"], data["mass"], data["bruise_volume"])]
+    bad = [[0.1, "steel", 0.18, 1e300, 1e-6], [0.1, "steel", 1e200, 0.075, 1e-6], [0.1, "steel", 168, 0.075, 1e-6]]
+    path = write_csv(tmp_path / "tests.csv", ["drop_height", "surface", "mass", "diameter", "bruise_volume"],
+                     rows + bad)
+    status, out, err = run_script(script, path, "--fruit", "apple", "--criterion", "none", "--json")
+    assert status == 0 and "Traceback" not in err, err
+    n = len(rows) + 1
+    assert f"line {n + 1}: diameter must lie within" in err and f"line {n + 2}: mass must lie within" in err
+    assert err.count("the row is skipped") == 2
+    assert err.count("mass = 168 kg is outside the plausible range for fruit") == 1
+
+
 def test_the_fit_is_the_same_in_any_units_and_silent_at_extreme_scales():
     """The likelihood is invariant to the units (damage/fitting.py fits in units of the tests' geometric means): a
     lot with energies × 1e-200 and volumes × 1e-250 gives BS × 1e-50 and W_th × 1e-200 (1e-6 relative: the

@@ -89,7 +89,6 @@ def fit_damage(tests, *, fruit: str | None = None, criterion: str | None = None,
     contact width 1.4 × bruise width: Z. Stropek & K. Gołacki, Postharvest Biol. Technol. 163 (2020) 111120.
     Criteria: docs/bruise.md.
     """
-    from fruitimpact.damage.fitting import MODELS as FIT_MODELS
     from fruitimpact.impact.outputs import CSV_FORMAT, atomic_write, check_output
     from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.registries import REGISTRIES
@@ -139,6 +138,8 @@ def fit_damage(tests, *, fruit: str | None = None, criterion: str | None = None,
         warnings.append(f"{where}: {message}; the row is skipped")
     energy, outcome, impact_energy = impacts.energy[keep], values[keep], table.energy[keep]
     surfaces = [s for s, k in zip(table.surface, keep) if k]
+    from fruitimpact.damage.fitting import MODELS as FIT_MODELS  # numpy from here: every argument is answered
+
     model = FIT_MODELS[table.outcome.model]
     fit = model(energy, outcome)
     names = _by_use(surfaces)
@@ -202,9 +203,9 @@ def fit_damage(tests, *, fruit: str | None = None, criterion: str | None = None,
         def write(tmp):
             with open(tmp, "w", encoding="utf-8", newline="") as handle:
                 handle.write(text)
+            read_fruit_file(tmp)  # it must load as the library's, with the same checks, before it replaces anything
 
         atomic_write(output, write, "output")
-        read_fruit_file(output)  # the file must load as the library's: it is read back with the same checks
         report["output"] = os.fspath(output)
     elif output is not None:
         warnings.append(f"nothing fitted: {output} is not written")

@@ -198,6 +198,22 @@ def _flag(cell) -> float:
     raise ValueError(f"bruised must be 1 or 0 (true/false, yes/no); got {cell!r}")
 
 
+#: How far beyond the plausible range for fruit (``INPUTS[name].plausible``) a test's mass or diameter may lie
+#: before its row is refused: a factor of 100 either side (a typo of units stays a warning, an absurd value is no
+#: fruit impact and would overflow the impact's arithmetic).
+SIZE_FACTOR = 100.0
+
+
+def _size_check(name: str, value: float, cell) -> None:
+    from fruitimpact.impact.quantities import INPUTS
+
+    plausible = INPUTS[name].plausible
+    low, high = plausible.low / SIZE_FACTOR, plausible.high * SIZE_FACTOR
+    if not low <= value <= high:
+        raise ValueError(f"{name} must lie within [{low:g}, {high:g}] {INPUTS[name].si_unit} (100 times beyond the "
+                         f"plausible range for fruit), where no fruit impact is computed; got {cell!r}")
+
+
 def _speed_check(column: str, speed: float, cell) -> None:
     low, high = SPEED_LIMITS
     if not low <= speed <= high:
@@ -290,6 +306,7 @@ def read_tests(tests, *, fruit_diameter: float | None = None) -> Tests:
             if "mass" not in row:
                 raise ValueError("mass must be given [kg]")
             mass = check_value("mass", row["mass"])
+            _size_check("mass", mass, row["mass"])
             key = given[0]
             if key == "drop_height":
                 height = check_value("drop_height", row[key])
@@ -308,6 +325,8 @@ def read_tests(tests, *, fruit_diameter: float | None = None) -> Tests:
                                                 f"{mass * 1e3:.4g} g fruit, outside the plausible range for fruit, "
                                                 f"[{velocity.plausible.low:g}, {velocity.plausible.high:g}] m/s")
             diameter = check_value("diameter", row["diameter"]) if "diameter" in row else math.nan
+            if "diameter" in row:
+                _size_check("diameter", diameter, row["diameter"])
             for name, value in (("mass", mass), ("diameter", diameter)):
                 if math.isfinite(value) and not INPUTS[name].plausible.contains(value):
                     implausible.add(name, where, implausible_message(INPUTS[name], value))
