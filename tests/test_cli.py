@@ -718,3 +718,21 @@ def test_the_risk_map_spans_its_axis_whatever_the_command_gives_for_it(cli):
     assert report["risk_map"]["safe_height"] == plain["risk_map"]["safe_height"]
     assert report["risk_map"]["incidence_heights"] == plain["risk_map"]["incidence_heights"]
     assert report["risk_map"]["lot"]["rows"] == 20
+
+
+def test_no_output_is_written_over_a_file_the_command_reads(cli, tmp_path):
+    """A review wrote a sphere's figure over its own log (--plot LOG) and a risk map over the fruit file it was
+    drawn for (--map-csv FRUIT), both with exit 0: the user's data lost.  Every command's outputs are checked
+    against the files it reads (cli.common.INPUT_FILE_ARGS), before any work, and the input is left as it was."""
+    log = tmp_path / "log.png"
+    log.write_bytes(open("examples/sphere-log.csv", "rb").read())
+    before = log.read_bytes()
+    status, out, err = cli.run("sphere", str(log), "--sphere", "is-1987", "--fruit", "apple", "-n", "20",
+                               "--plot", str(log))
+    assert status == 2 and out == "" and err.startswith("fruitimpact sphere: error: argument --plot:")
+    assert "is the file LOG the command reads" in err and log.read_bytes() == before
+    fruit = tmp_path / "fruit.csv"
+    fruit.write_text("not read: refused first\n")
+    status, out, err = cli.run("safe-height", "--fruit", str(fruit), "--map", "surface", "--map-csv", str(fruit))
+    assert status == 2 and "argument --map-csv:" in err and "is the file --fruit the command reads" in err
+    assert fruit.read_text() == "not read: refused first\n"

@@ -39,16 +39,31 @@ def _help(quantity) -> str:
     return f"{quantity.doc}{unit}"
 
 
-def check_outputs(*outputs) -> None:
+#: The arguments through which a command reads a file of the user's (positional files, a fruit file, a sphere's
+#: calibration): no output may be written over one of them.
+INPUT_FILE_ARGS = (("file", "FILE"), ("log", "LOG"), ("line", "LINE"), ("tests", "TESTS"), ("fruit", "--fruit"),
+                   ("sphere_calibration", "--sphere-calibration"))
+
+
+def check_outputs(*outputs, args=None) -> None:
     """Each ``(option, path, formats)`` whose path is given: a file that can be written, of one of ``formats``
-    (``impact.outputs.check_output``), before any work; a figure (``FIGURE_FORMATS``) also needs matplotlib."""
+    (``impact.outputs.check_output``), and not one of the files the command reads (``args``'
+    ``INPUT_FILE_ARGS``: a figure written over the log it was drawn from loses the user's data), before any work;
+    a figure (``FIGURE_FORMATS``) also needs matplotlib."""
     import importlib.util
+    import os
 
     from fruitimpact.impact.outputs import FIGURE_FORMATS, check_output
 
+    inputs = [(name, getattr(args, dest)) for dest, name in INPUT_FILE_ARGS
+              if isinstance(getattr(args, dest, None), str) and os.path.isfile(getattr(args, dest))]
     for option, path, formats in outputs:
         if path is None:
             continue
+        for name, read in inputs:
+            if os.path.exists(path) and os.path.samefile(path, read):
+                raise UsageError(f"argument {option}: {path!r} is the file {name} the command reads: write to "
+                                 f"another file")
         _library_call(check_output, path, option, formats)
         if formats is FIGURE_FORMATS and importlib.util.find_spec("matplotlib") is None:
             raise UsageError(f"argument {option}: figures need matplotlib: pip install 'fruitimpact[plot]'")

@@ -64,7 +64,7 @@ def cmd_safe_height(args) -> int:
     kwargs = _without_velocity(args)
     if "drop_height" in kwargs:
         raise UsageError("argument --drop-height: safe-height finds the drop height; leave it out")
-    check_outputs(("--map-csv", args.map_csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--map-csv", args.map_csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS), args=args)
     if (args.map_csv or args.plot) and not args.map:
         args.map = "surface"
     for option, value in (("--map-fruit", args.map_fruit), ("--map-seed", args.map_seed),
@@ -159,7 +159,7 @@ def cmd_line(args) -> int:
         points = read_line(args.line)
     except ValueError as exc:
         raise UsageError(f"argument LINE: {exc}") from None
-    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS), args=args)
     report = _library_call(audit_line, points, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
                            alternatives=args.alternatives, **lot_inputs(args))
     criterion = report["criterion"]

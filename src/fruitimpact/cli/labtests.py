@@ -22,7 +22,7 @@ _ROWS = (("bruise threshold energy  W_th", "bruise_energy", 1.0, "J"),
 def cmd_fit_damage(args) -> int:
     from fruitimpact.handling.droptests import fit_damage
 
-    check_outputs(("-o/--output", args.output, CSV_FORMAT))
+    check_outputs(("-o/--output", args.output, CSV_FORMAT), args=args)
     report = _library_call(fit_damage, args.tests, fruit=args.fruit, criterion=args.criterion, name=args.name,
                            output=args.output)
     for warning in report["warnings"]:

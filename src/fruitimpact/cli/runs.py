@@ -95,7 +95,7 @@ def cmd_sweep(args) -> int:
     from fruitimpact.runs import tasks
 
     order = list(getattr(args, "order", None) or [])
-    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS), args=args)
     plan, axes = _library_call(tasks.sweep_plan, {dest: getattr(args, dest) for dest in order}, args.chunk_size)
     try:
         name = runs.characteristic(args.characteristic).name
@@ -168,7 +168,7 @@ def cmd_population(args) -> int:
         tasks.population_plan, inputs, rows=args.rows, seed=args.seed, spreads=not args.no_spreads,
         characteristics=args.characteristics, thresholds=args.threshold or (), sample_size=args.sample_size,
         chunk_size=args.chunk_size, write_rows=args.output is not None)
-    check_outputs(("--hist", args.hist, FIGURE_FORMATS))
+    check_outputs(("--hist", args.hist, FIGURE_FORMATS), args=args)
     summary = _run(args, plan, percentiles=percentiles)
     if summary is None:
         return 130

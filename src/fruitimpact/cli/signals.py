@@ -119,7 +119,7 @@ class _Progress:
 def cmd_analyze(args) -> int:
     rate = _rate(args.rate)
     lanes = read_option_count("--lanes", args.lanes, 1)  # more than MAX_LANES: the detector refuses them
-    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS), args=args)
     # every option checked before the file is read, and before the detector and the fit (numba) are imported
     analysis_from(args, rate if rate is not None else 1e12, rate_known=rate is not None)
     from fruitimpact.signals.read import open_recording

@@ -89,7 +89,7 @@ def _overlays(args) -> list[dict]:
 def cmd_simulate(args) -> int:
     kwargs = _simulate_kwargs(args)
     overlays = _overlays(args)
-    check_outputs(("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--csv", args.csv, CSV_FORMAT), ("--plot", args.plot, FIGURE_FORMATS), args=args)
     from fruitimpact.impact.simulation import simulate  # the engine (numba) only once the options are good
 
     result = _library_call(simulate, **kwargs)

@@ -39,7 +39,7 @@ def cmd_sphere(args) -> int:
     from fruitimpact.spheres.audit import sphere_audit
     from fruitimpact.spheres.log import skipped_lines
 
-    check_outputs(("--plot", args.plot, FIGURE_FORMATS))
+    check_outputs(("--plot", args.plot, FIGURE_FORMATS), args=args)
     options = {dest: getattr(args, dest) for dest, *_ in SPHERE_OPTIONS if getattr(args, dest) is not None}
     report = _library_call(sphere_audit, args.log, sphere=args.sphere, rows=args.rows, seed=args.seed,
                            spreads=not args.no_spreads, chart=bool(args.plot), **options, **lot_inputs(args))

@@ -31,13 +31,15 @@ def _shown(number) -> str:
     return "open" if number is None else f"{number:.6g}"
 
 
-def _value(estimate, spread, interval, unit: str, source: str, what: str, spread_text: str, basis: str = ""):
-    """A library ``Value`` of a fitted estimate: its range the fruit-to-fruit ``spread`` (low, high) the fit found
-    (what a lot draws from), or the value itself where the fit resolved none (the library's "no spread known");
-    the 95 % interval of the estimate in the note."""
+def _value(report: dict, key: str, unit: str, source: str, what: str, spread_text: str, basis: str = ""):
+    """A library ``Value`` of the fitted estimate ``report[key]``: its range the fruit-to-fruit spread the fit found
+    (``report["fruit_ranges"][key]``: what a lot draws from), or the value itself where the fit resolved none (the
+    library's "no spread known"); the 95 % interval (``report[key + "_low"]``, ``report[key + "_high"]``) in the
+    note."""
     from fruitimpact.library.catalogue import Value
 
-    low95, high95 = interval
+    estimate, spread = report[key], report["fruit_ranges"].get(key)
+    low95, high95 = report[f"{key}_low"], report[f"{key}_high"]
     if spread is None:
         low = high = estimate
         ranged = "range: the value (the tests do not resolve a fruit-to-fruit spread)"
@@ -59,20 +61,17 @@ def _fitted_fruit(report: dict, template, name: str):
     source = f"derived: {FITTED_BY} to {report['tests_file']}, {count} tests"
     basis = ("impact: the fruit's share of the impact energy (m g h of a drop, the pendulum's energy) on each test's "
              "surface, as a simulation compares it")
-    ranges = report["fruit_ranges"]
     fields = {"bruise_susceptibility": None, "bruise_threshold_energy": None, "failure_stress": None}
     if report["bruise_susceptibility"] is not None:
         fields["bruise_susceptibility"] = _value(
-            report["bruise_susceptibility"], ranges.get("bruise_susceptibility"),
-            (report["bruise_susceptibility_low"], report["bruise_susceptibility_high"]), "m^3/J", source,
+            report, "bruise_susceptibility", "m^3/J", source,
             f"the median bruise volume per joule above a fruit's threshold, maximum-likelihood estimate "
             f"({MODEL_TEXT[report['model_name']]}); basis: {basis}",
             f"the volume scatter σ_v = {report['volume_scatter']:.3g}, which holds the measurement's scatter too: an "
             f"upper bound of the fruit-to-fruit spread" if report["volume_scatter"] is not None else "", "impact")
     if report["bruise_energy"] is not None:
         fields["bruise_threshold_energy"] = _value(
-            report["bruise_energy"], ranges.get("bruise_energy"),
-            (report["bruise_energy_low"], report["bruise_energy_high"]), "J", source,
+            report, "bruise_energy", "J", source,
             f"median of the fruit's thresholds (half the fruit bruise at it), maximum-likelihood estimate; basis: "
             f"{basis}",
             f"the thresholds' spread σ_t = {report['threshold_spread']:.3g}" if report["threshold_spread"] is not None
@@ -80,8 +79,7 @@ def _fitted_fruit(report: dict, template, name: str):
     criterion, criterion_source, criterion_note = None, "", ""
     if report["failure_stress"] is not None:
         fields["failure_stress"] = _value(
-            report["failure_stress"], ranges.get("failure_stress"),
-            (report["failure_stress_low"], report["failure_stress_high"]), "Pa",
+            report, "failure_stress", "Pa",
             f"{source} (the {report['failure_stress_rule']} criterion's stress at the threshold energy on "
             f"{report['failure_stress_surface']}, with the {template.name} entry's modulus, Poisson ratio, size and "
             f"mass)", f"stress at bruise onset under the {report['criterion']} criterion",
