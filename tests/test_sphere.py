@@ -239,6 +239,21 @@ def test_calibration_fits_the_sphere_on_a_rigid_plate(tmp_path):
     assert report["calibration"]["drops"] == 4
 
 
+def test_a_calibration_stiffer_than_any_solid_fails_the_audit(tmp_path):
+    """A review's calibration file read 1e9 g at every drop: the fit gave E*_s ~ 3e18 MPa and the audit said ok,
+    turning rigid points into rubber.  No solid is stiffer than diamond (E* ≈ 1.2 TPa on a rigid plate), so the
+    calibration has failed and the audit's status says so (exit 1), with the reason."""
+    calibration = tmp_path / "absurd.csv"
+    calibration.write_text("drop_height,peak_acceleration,velocity_change,duration\n"
+                           "5cm,1e9,1.8,0.0029\n10cm,1e9,2.5,0.0029\n20cm,1e9,3.6,0.0029\n")
+    log = write_log(tmp_path / "log.csv", passes=1)
+    done = run("sphere", log, "--sphere", "is-1987", "--sphere-calibration", calibration, "--fruit", "apple",
+               "-n", 20, "--json", check=False)
+    report = json.loads(done.stdout)
+    assert done.returncode == 1 and report["status"] == "failed" and report["calibration"]["status"] == "failed"
+    assert "stiffer than any solid" in report["message"]
+
+
 def test_a_raw_trace_is_read_through_the_detector(tmp_path):
     """A raw acceleration trace at 20 kHz (the generator's pulses sampled, 1 g at rest, 0.3 g noise): impacts found
     by the detector `analyze` uses; drop heights within 5 % and surface moduli within 15 % (ΔV by the rectangle

@@ -374,7 +374,9 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                                 criterion=criterion, spreads=spreads, inputs=inputs)
     worst = report["worst_point"]
     status, message = "ok", ""
-    if any(entry["incidence"] is None for entry in point_rows):
+    if calibration is not None and calibration["status"] == "failed":
+        status, message = "failed", f"the sphere's calibration failed: {calibration['message']}"
+    elif any(entry["incidence"] is None for entry in point_rows):
         status, message = "failed", "a transfer point has no reading reproduced by an impact (see its message)"
     elif report["status"] != "ok":
         status, message = report["status"], report["message"]

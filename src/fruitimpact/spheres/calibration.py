@@ -33,6 +33,9 @@ CALIBRATION_COLUMNS = {
     "velocity_change": ("velocity", "m/s", True),
     "duration": ("time", "s", False),
 }
+#: A sphere's contact modulus no solid exceeds [Pa] (diamond's E* on a rigid plate is ~1.2 TPa): a calibration
+#: giving more has ``failed``.
+MAX_SPHERE_MODULUS = 1.2e12
 #: A single drop's stiffness scattering by more than this (relative sd), or durations missed by more than
 #: POOR_DURATION (rms), make a calibration ``poor``: the sphere is then not a Hertz body to its readings'
 #: precision, and every surface modulus it gives is that uncertain.
@@ -114,6 +117,10 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
                    f"{scatter:.1%} (limit {POOR_SCATTER:.0%})" + ("" if math.isnan(residual) else
                    f", durations predicted within {residual:.1%} rms (limit {POOR_DURATION:.0%})") +
                    "; surface moduli from this sphere are that uncertain")
+    if not centre <= MAX_SPHERE_MODULUS:
+        status = "failed"
+        message = (f"E*_s = {centre / 1e6:.4g} MPa: stiffer than any solid (above {MAX_SPHERE_MODULUS / 1e9:g} GPa, "
+                   f"diamond's E*): these readings are not the sphere's drops onto a rigid plate")
     warnings = []
     high = int(np.count_nonzero(height > IMPLAUSIBLE_HEIGHT))
     if high:
