@@ -254,6 +254,22 @@ def test_a_calibration_stiffer_than_any_solid_fails_the_audit(tmp_path):
     assert "stiffer than any solid" in report["message"]
 
 
+def test_a_reading_beyond_any_transfer_point_fails_its_point_only(tmp_path):
+    """A review added one reading of a 14 m equivalent drop (3,600 g, 31.6 m/s) to a good log: the whole audit was
+    refused with a line naming no argument.  Such a reading is no handling impact: it is left out (one warning),
+    its point fails, and the others are audited."""
+    log = write_log(tmp_path / "log.csv", passes=1)
+    with open(log, "a") as handle:
+        handle.write("900,3600,31.6,0.00167,beyond\n")
+    done = run("sphere", log, *SPHERE_OPTIONS, "--fruit", "apple", "-n", 20, "--json", check=False)
+    report = json.loads(done.stdout)
+    assert done.returncode == 1 and report["status"] == "failed", done.stderr
+    assert "equivalent drop above the 10 m a transfer point may have" in done.stderr
+    by_name = {point["name"]: point for point in report["points"]}
+    assert by_name["beyond"]["status"] == "failed"
+    assert all(point["status"] == "ok" for name, point in by_name.items() if name != "beyond")
+
+
 def test_a_raw_trace_is_read_through_the_detector(tmp_path):
     """A raw acceleration trace at 20 kHz (the generator's pulses sampled, 1 g at rest, 0.3 g noise): impacts found
     by the detector `analyze` uses; drop heights within 5 % and surface moduli within 15 % (ΔV by the rectangle

@@ -127,8 +127,8 @@ def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
     if not isinstance(point.name, str) or not point.name:
         raise ValueError(f"{where}: name must be a non-empty text; got {point.name!r}")
     height = point.drop_height
-    if isinstance(height, bool) or not isinstance(height, (int, float)) or not 0.0 < height <= 10.0:
-        raise ValueError(f"{where}: drop_height must be in (0, 10] m; got {height!r}")
+    if isinstance(height, bool) or not isinstance(height, (int, float)) or not 0.0 < height <= MAX_POINT_HEIGHT:
+        raise ValueError(f"{where}: drop_height must be in (0, {MAX_POINT_HEIGHT:g}] m; got {height!r}")
     if point.surface not in SURFACE_CHOICES or point.surface == "fruit":
         raise ValueError(f"{where}: surface must be one of {', '.join(s for s in SURFACE_CHOICES if s != 'fruit')}; "
                          f"got {point.surface!r} (fruit on fruit: set fruit_on_fruit to true)")
@@ -314,6 +314,8 @@ __all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT
            "audit", "audit_line", "read_line"]
 
 
+#: Highest drop a transfer point may have [m] (the safe-height search's own ceiling, ``heights.HIGHEST``).
+MAX_POINT_HEIGHT = 10.0
 #: Most fruit of one line audit.
 MAX_LINE_FRUIT = 10_000_000
 #: Fruit in a line audit's lot by default (the command's and the function's).

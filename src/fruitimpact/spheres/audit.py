@@ -143,7 +143,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     simulating the reaction to impact of apples on rigid plane surfaces"; docs/tasks/sphere.md.
     """
     from fruitimpact.handling.heights import AXIS_INPUTS
-    from fruitimpact.handling.line import LINE_FRUIT, MAX_LINE_FRUIT, Pad, TransferPoint, audit_line
+    from fruitimpact.handling.line import LINE_FRUIT, MAX_LINE_FRUIT, MAX_POINT_HEIGHT, Pad, TransferPoint, audit_line
     from fruitimpact.impact.lots import MAX_SEED, read_lot
     from fruitimpact.impact.presets import fruit_criterion
     from fruitimpact.impact.units import parse_quantity
@@ -266,7 +266,17 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                             f"impact on a half-space (fit misfit above {SHAPE_MISFIT:.0%} of the peak): their drop "
                             f"heights may be far off (see their messages)")
     ok = result.status == 0
-    bad = int(np.count_nonzero(~ok))
+    # a reading whose equivalent drop lies beyond what a transfer point may have is no handling impact: left out
+    # like a reading no impact reproduces (it had refused the whole line audit)
+    beyond = ok & ~(result.drop_height <= MAX_POINT_HEIGHT)
+    if beyond.any():
+        first = int(np.flatnonzero(beyond)[0])
+        warnings.append(f"{int(beyond.sum())} of {len(readings)} readings give an equivalent drop above the "
+                        f"{MAX_POINT_HEIGHT:g} m a transfer point may have (the first, row "
+                        f"{int(readings.rows[first])}: {result.drop_height[first]:.4g} m); left out of the points' "
+                        f"figures")
+        ok &= ~beyond
+    bad = int(np.count_nonzero(~ok & ~beyond))
     if bad:
         first = int(np.flatnonzero(~ok)[0])
         warnings.append(f"{bad} of {len(readings)} readings reproduced by no impact (the first, row "
