@@ -130,7 +130,7 @@ def test_skipped_rows_are_listed_as_the_cli_prints_them(server, tmp_path, monkey
     body = _post(server + "api/sphere", request)[1]
     assert "refused" not in body, body
     done = _cli(tmp_path, *shlex.split(body["command"])[1:])
-    printed = [line.removeprefix("fruitimpact sphere: ") for line in done.stderr.splitlines()
+    printed = [line.removeprefix("fruitimpact sphere: warning: ") for line in done.stderr.splitlines()
                if line.endswith("; row skipped")]
     assert len(body["skipped"]) == 2 and body["skipped"] == printed
     assert body["report"] == _reference(tmp_path, monkeypatch, "survey.csv", sphere_calibration=CALIBRATION,

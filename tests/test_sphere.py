@@ -328,6 +328,8 @@ def test_bad_rows_are_reported_and_skipped(tmp_path):
     assert report["readings"] == 1 and report["impacts"][0]["drop_height"] == pytest.approx(0.05, rel=0.01)
     skipped = [line for line in result.stderr.splitlines() if "row skipped" in line]
     assert [re.search(r", row (\d+)", line).group(1) for line in skipped] == ["3", "4", "5"]
+    # with --json stderr holds warning lines only (the skipped rows are warnings too)
+    assert all(line.startswith("fruitimpact sphere: warning: ") for line in result.stderr.splitlines())
     assert "velocity_change" in skipped[0] and "peak_acceleration" in skipped[2]
 
 

@@ -44,7 +44,7 @@ def cmd_sphere(args) -> int:
     report = _library_call(sphere_audit, args.log, sphere=args.sphere, rows=args.rows, seed=args.seed,
                            spreads=not args.no_spreads, chart=bool(args.plot), **options, **lot_inputs(args))
     for line in skipped_lines(args.log, report["skipped"]):
-        print(f"{PROG} sphere: {line}", file=sys.stderr)
+        print(f"{PROG} sphere: warning: {line}", file=sys.stderr)
     for warning in report["warnings"]:
         print(f"{PROG} sphere: warning: {warning}", file=sys.stderr)
     if args.plot:
