@@ -305,9 +305,10 @@ def test_a_bad_table_is_refused_with_one_line_and_the_same_value_error(cli, tmp_
     (("--fruit", "nowhere.csv"), "argument --fruit: fruit must be one of jonathan-apple"),
     (("--fruit", "folder.csv"), "argument --fruit: fruit must be one of jonathan-apple, apple, pear, peach, tomato, "
                                 "potato, kiwifruit or a fruit file (.csv); 'folder.csv' is a directory, not a file"),
-    (("-o", "tests.csv"), "argument -o/--output: 'tests.csv' is the table of tests itself: write the fitted fruit "
-                          "to another file"),
-    (("-o", "./sub/../tests.csv"), "argument -o/--output: './sub/../tests.csv' is the table of tests itself"),
+    # the CLI refuses an output over any file it reads (cli.common.check_outputs) before the library's own check
+    (("-o", "tests.csv"), "argument -o/--output: 'tests.csv' is the file TESTS the command reads: write to another "
+                          "file"),
+    (("-o", "./sub/../tests.csv"), "argument -o/--output: './sub/../tests.csv' is the file TESTS the command reads"),
     (("--fruit", "banana"), "argument --fruit: fruit must be one of jonathan-apple"),
     (("--criterion", "bend"), "argument --criterion: criterion must be one of"),
     (("--name", "Fitted Apple"), "argument --name: the fitted fruit's name must be lower-case"),
