@@ -301,14 +301,10 @@ def _analyse(cli, tmp_path, name):
     return [json.loads(line) for line in out.splitlines()], truth
 
 
-#: Scenarios where a rebound lands on the next fruit (20–35 % of the contacts overlap another): the two are told
-#: apart by a joint fit (every contact found, none invented, none misflagged at these sizes), but pieces whose
-#: rises overlap are less precise than lone pulses (peak force median 0.5 %, p95 2.5–4.5 %; time to peak up to
-#: 4 %), above the 1 % / 2 % goals.  Open limitation of issue 13, tracked here: strict, so this list must shrink
-#: when it is fixed.
-OPEN = {"chain10": "peak force and time to peak of fruit and rebounds landing 0.5-2 ms apart (35 % of contacts "
-                   "overlap): split pieces p95 2.5-4.5 %",
-        "noisy": "peak force of fruit and rebounds landing 0.5-2 ms apart: split pieces p95 2.5-4.5 %"}
+#: Scenarios whose goals are still open (strict xfail: this must shrink when one is met).  Empty since split pieces
+#: are held to ±1 % on their peak (``analysis.PIECE_PRECISION``): chain10 and noisy, where a rebound lands on the
+#: next fruit in 20–35 % of the contacts, had pieces at p95 2.5–4.5 % before.
+OPEN: dict[str, str] = {}
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(name in OPEN, reason=OPEN.get(name, ""),
@@ -335,5 +331,5 @@ def test_line_grading_meets_the_issue_goal(cli, tmp_path):
     assert g["clear"] >= 30
     assert g["clear_accuracy"] >= lg.GRADING_GOAL, (g["clear_right"], g["clear"], g["confusion"], g["wrong"])
     # a clear fruit on which a rebound landed is told apart and graded, or is an overlap without a class (item 2:
-    # a piece whose peak the samples do not fix to ±3 % gets none): never a wrong class (0 of 16 at benchmark size)
+    # a piece whose peak the samples do not fix to ±1 % gets none): never a wrong class (0 of 16 at benchmark size)
     assert g["overlapped_wrong"] == 0, (g["overlapped_clear"], g["overlapped_right"], g["confusion"])

@@ -234,33 +234,34 @@ def test_an_overlap_that_cannot_be_told_apart_has_no_firmness():
 
 
 @pytest.mark.parametrize("seed", range(4))
-@pytest.mark.parametrize("gap", [2.0e-3, 3.0e-3])
-def test_two_fruit_landing_together_are_told_apart_though_no_dip_shows(gap, seed):
-    """Two fruit touching 2–3 ms apart (about one time to peak, 2.0 ms) make one unimodal pulse (no dip: the second
+def test_two_fruit_landing_together_are_told_apart_though_no_dip_shows(seed):
+    """Two fruit touching 3 ms apart (about 1.5 times to peak, 2.0 ms) make one unimodal pulse (no dip: the second
     lands on the first's rise), but no single fruit's force law fits it (it misses by several % of the peak
     beyond the noise, above analysis.MISFIT_LIMIT's 1.8 %), and the joint fit started from the grid of pulse
     pairs (signals/split.py) tells them apart: two reports, each onset within 0.1 ms of its fruit's, peaks
-    within 4 % (the joint covariance gives the second ≤ 2 % sd here; 6 seeds gave ≤ 3 %), stiffness within
-    8 % (it also rests on the tail, which lies under the other pulse)."""
+    within 2 % (a piece is kept only when the joint fit fixes its peak to ±1 %, analysis.PIECE_PRECISION: 2 sd;
+    4 seeds gave ≤ 0.65 %), stiffness within 8 % (it also rests on the tail, which lies under the other pulse)."""
     a = impact()
     b = impact(mass=0.7 * MASS)
+    gap = 3.0e-3
     first, second = _reports(_signal([0.1, 0.1 + gap], [a, b], 6000, seed=seed))
     for report, imp, onset in ((first, a, 0.1), (second, b, 0.1 + gap)):
         assert report["status"] == "ok" and "two fruit in one contact" in report["message"]
         assert report["start_time"] == pytest.approx(onset, abs=1e-4)
-        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.04)
+        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.02)
         assert report["stiffness"] == pytest.approx(imp["K"], rel=0.08)
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_two_fruit_whose_pulses_the_samples_cannot_separate_are_one_overlap(seed):
-    """Two fruit 1.5 ms apart: two pulses fit, but the samples fix the second one's peak only to ±5–6 % (the
-    joint fit's standard error; errors of 1–7 % were seen), above analysis.PIECE_PRECISION's 3 %: one report
-    with status "overlap", no firmness, no class: never two grades the data do not support, never one fruit
-    fitted through both."""
+@pytest.mark.parametrize("gap", [1.5e-3, 2.0e-3])
+def test_two_fruit_whose_pulses_the_samples_cannot_separate_are_one_overlap(gap, seed):
+    """Two fruit 1.5–2 ms apart: two pulses fit, but the samples fix the second one's peak only to ±2–6 % (the
+    joint fit's standard error; at 3 % allowed, errors of 1–7 % were seen), above analysis.PIECE_PRECISION's
+    1 %: one report with status "overlap", no firmness, no class: never two grades the data do not support,
+    never one fruit fitted through both."""
     a = impact()
     b = impact(mass=0.7 * MASS)
-    (report,) = _reports(_signal([0.1, 0.1015], [a, b], 6000, seed=seed))
+    (report,) = _reports(_signal([0.1, 0.1 + gap], [a, b], 6000, seed=seed))
     assert report["status"] == "overlap" and "could not be told apart" in report["message"]
     assert math.isnan(report["firmness_c"]) and "stiffness" not in report or report.get("stiffness") is None
 
@@ -276,26 +277,47 @@ def _fruit_then_rebound_with_the_next(gap, next_mass, seed=5):
 
 
 @pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("gap", [1.2e-3, -1.0e-3])
+@pytest.mark.parametrize("gap", [2.0e-3, -3.0e-3])
 def test_a_rebound_and_the_next_fruit_landing_together_are_told_apart(gap, seed):
     """The previous fruit's rebound is due (its flight 2 e V/g from its own measured e and the line's V) and the
-    next fruit lands 1–1.2 ms from it: one smooth pulse that one force law fits within the misfit limit, but
-    two pulses fit it far better (rebounds.rebounds_due, analysis.SPLIT_GAIN), so it is split: the rebound is
-    the first fruit's (rebound_of), the next fruit a new one.  Tolerances from 30 seeds per gap (max seen in
-    brackets): onsets 0.2 ms (0.1), the new fruit's peak 7 % (6.0 %) and stiffness 10 % (8.1 %), the rebound's
-    peak 15 % (13 %: drawn toward the peak physics expects within that expectation's own ±12 % sd)."""
+    next fruit lands 2–3 ms from it: one smooth pulse that one force law fits within the misfit limit, but two
+    pulses fit it far better (rebounds.rebounds_due, analysis.SPLIT_GAIN), so it is split: the rebound is the
+    first fruit's (rebound_of), the next fruit a new one, graded from its own piece.  Tolerances from 20 seeds
+    per gap (max seen in brackets): onsets 0.2 ms, the new fruit's peak 2 % (1.2 %: its piece is fixed to ±1 %,
+    analysis.PIECE_PRECISION) and stiffness 10 % (8.5 %).  The rebound landing 2 ms after the next fruit, on its
+    peak, is fixed only to ±1.5–3 %: it keeps its parent but is an "overlap" without firmness or fit (its
+    amplitude traded off against the fruit's); 3 ms before it, it is measured, peak within 2 % (0.7 %)."""
     a, rebound, b, landing, x = _fruit_then_rebound_with_the_next(gap, 1.1, seed=seed)
     first, *rest = _reports(x)
     assert first["status"] == "ok" and not first["rebound"]
-    assert len(rest) == 2 and all("two fruit in one contact" in r["message"] for r in rest)
+    assert len(rest) == 2
     (back,) = [r for r in rest if r["rebound"]]
     (new,) = [r for r in rest if not r["rebound"]]
     assert back["rebound_of"] == first["sequence"]
     assert back["start_time"] == pytest.approx(landing, abs=2e-4)
+    assert new["status"] == "ok" and "two fruit in one contact" in new["message"]
     assert new["start_time"] == pytest.approx(landing - gap, abs=2e-4)
-    assert back["peak_force"] == pytest.approx(rebound["F"], rel=0.15)
-    assert new["peak_force"] == pytest.approx(b["F"], rel=0.07)
+    assert new["peak_force"] == pytest.approx(b["F"], rel=0.02)
     assert new["stiffness"] == pytest.approx(b["K"], rel=0.10)
+    if gap > 0:
+        assert back["status"] == "overlap" and "determined to" in back["message"]
+        assert math.isnan(back["firmness_c"]) and math.isnan(back["stiffness"])
+    else:
+        assert back["status"] == "ok" and back["peak_force"] == pytest.approx(rebound["F"], rel=0.02)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("gap", [1.2e-3, -1.0e-3])
+def test_a_rebound_and_the_next_fruit_landing_within_a_millisecond_are_one_overlap(gap, seed):
+    """The same 1–1.2 ms apart: two pulses fit far better than one, but the joint fit fixes the new fruit's peak
+    only to a few % (at 3 % allowed, its peak was off by up to 6 % and its stiffness by 8 %): one "overlap" report,
+    no firmness, no class (analysis.PIECE_PRECISION)."""
+    *_, x = _fruit_then_rebound_with_the_next(gap, 1.1, seed=seed)
+    first, *rest = _reports(x)
+    assert first["status"] == "ok" and not first["rebound"]
+    (overlap,) = rest
+    assert overlap["status"] == "overlap" and "could not be told apart" in overlap["message"]
+    assert math.isnan(overlap["firmness_c"]) and overlap.get("stiffness") is None
 
 
 def test_a_fruit_alone_where_a_rebound_is_due_stays_one_fruit():
@@ -312,11 +334,12 @@ def test_a_fruit_alone_where_a_rebound_is_due_stays_one_fruit():
 
 
 @pytest.mark.parametrize("seed", [3, 4, 5])
-def test_a_fruit_and_two_rebounds_landing_together_are_three_contacts(seed):
+def test_a_fruit_and_two_rebounds_landing_together_are_never_graded_from_unfixed_pieces(seed):
     """Two fruit whose rebounds are both due where a third fruit lands: the new fruit, the first's rebound 1.2 ms
-    later and the second's 3.5 ms later make one contact.  Split in two, then the piece holding two pulses split
-    again (analysis._split_further): three reports, each rebound with its own parent, onsets within 0.3 ms, peaks
-    within 12 % (three overlapping rises share their amplitudes; 3 seeds gave ≤ 11 %)."""
+    later and the second's 3.5 ms later make one contact.  Split in two (the first's rebound apart), the rest
+    tried again as two (analysis._split_further); three overlapping rises share their amplitudes, and no piece's
+    peak is fixed to ±1 % (analysis.PIECE_PRECISION; at 3 % allowed, 11 of 20 seeds gave three contacts with
+    peaks up to 11 % off): every report is an overlap without firmness, and the rebound piece keeps its parent."""
     a, b = impact(), impact(mass=0.9 * MASS, restitution=0.5)
     back_a = impact(velocity=a["e"] * V_LINE, c=a["c"])
     back_b = impact(mass=0.9 * MASS, velocity=b["e"] * V_LINE, c=b["c"])
@@ -326,11 +349,8 @@ def test_a_fruit_and_two_rebounds_landing_together_are_three_contacts(seed):
     onsets = [landing - 0.0012, landing, landing + 0.0035]
     x = _signal([0.1, onset_b, *onsets], [a, b, c, back_a, back_b], 12000, seed=seed)
     first, second, *rest = _reports(x)
-    assert len(rest) == 3 and all("one of three fruit in one contact" in r["message"] for r in rest)
-    for report, imp, onset, parent in zip(rest, (c, back_a, back_b), onsets, (None, first, second)):
-        assert report["start_time"] == pytest.approx(onset, abs=3e-4)
-        assert report["peak_force"] == pytest.approx(imp["F"], rel=0.12)
-        assert report["rebound_of"] == (None if parent is None else parent["sequence"])
+    assert rest and all(r["status"] == "overlap" and math.isnan(r["firmness_c"]) for r in rest), rest
+    assert {r["rebound_of"] for r in rest if r["rebound"]} <= {first["sequence"], second["sequence"]}
 
 
 @pytest.mark.parametrize("seed", range(20))
@@ -445,3 +465,28 @@ def test_one_fruit_alone_is_never_an_overlap():
     for seed in range(20):
         (report,) = _reports(_signal([0.1], [a], 4000, seed=seed))
         assert report["status"] == "ok", report["message"]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_rebound_of_a_fruit_hidden_in_an_overlap_reports_its_pulse_without_mass_or_stiffness(seed):
+    """Six measured fruit, then two fruit 1.5 ms apart (one overlap: the second's peak is fixed only to ±6 %), then
+    the first hidden fruit's rebound alone: a rebound of the overlap (rebounds.judge_unmeasured).  Its impact
+    speed was never measured, so the fit cannot split m from K (only the pulse's shape and c V are fixed): mass
+    and stiffness are null and the message says why, but it is a fitted pulse, status ok, whose peak force and
+    time to peak are within 1 % and 2 % of the exact engine's (the single-pulse precision of
+    tests/test_signals_fit.py) and whose restitution is within 0.03 (the issue's goal)."""
+    rng = np.random.default_rng(4)
+    fruit = [impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=rng.uniform(0.55, 0.6)) for _ in range(6)]
+    hidden, beside = impact(restitution=0.57), impact(mass=0.7 * MASS)
+    back = impact(velocity=hidden["e"] * V_LINE, c=hidden["c"])
+    landing = 0.8 + hidden["T"] + 2 * hidden["e"] * V_LINE / G
+    x = _signal([0.1 + 0.1 * k for k in range(6)] + [0.8, 0.8015, landing], [*fruit, hidden, beside, back],
+                int(1.1 * RATE), seed=seed)
+    *_, overlap, rebound = _reports(x)
+    assert overlap["status"] == "overlap"
+    assert rebound["rebound"] and rebound["rebound_of"] == overlap["sequence"]
+    assert rebound["status"] == "ok" and "not split" in rebound["message"]
+    assert math.isnan(rebound["mass"]) and math.isnan(rebound["stiffness"])
+    assert rebound["peak_force"] == pytest.approx(back["F"], rel=0.01)
+    assert rebound["time_to_peak"] == pytest.approx(back["tc"], rel=0.02)
+    assert rebound["restitution"] == pytest.approx(back["e"], abs=0.03)
