@@ -13,7 +13,6 @@ pulse relations at known drops (speed is measured here; accuracy against solve_i
 from __future__ import annotations
 
 import math
-import resource
 import subprocess
 import sys
 import tempfile

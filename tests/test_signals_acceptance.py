@@ -12,10 +12,8 @@ the recording and every pulse within 4.5 %.
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
-import pytest
 
 
 def _run(cli, tmp_path, name, synth_args, analyze_args):
