@@ -43,7 +43,8 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
-                                         hidden_rebound, judge, judge_unmeasured, likeliest_hidden, rebounds_due,
+                                         hidden_rebound, judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
+                                         rebounds_due,
                                          refine, shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
@@ -252,7 +253,7 @@ class LineAnalyzer:
                           time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
                           contact_duration=(impact.end_index + 1 - impact.start_index) / analysis.rate,
                           impulse=float(np.sum(inside)) / analysis.rate)
-        return [self._contact(own, report, shape, status, message, due if status == "overlap" else ())]
+        return [self._contact(own, report, shape, status, message, due)]
 
     def _split_further(self, parts, rebounds: list[bool], due: list[PulseSummary]):
         """The pieces of a split, one of them split again where it holds a third pulse: when more than one earlier
@@ -322,10 +323,12 @@ class LineAnalyzer:
         return pieces
 
     def _contact(self, impact: DetectedImpact, report: dict, shape: dict | None, status: str, message: str,
-                 hidden: list[PulseSummary] | tuple = ()) -> dict:
-        """The rest of a contact's report: the rebound decision, the fit restated, the class.  ``hidden``: for an
-        overlap, the earlier contacts whose rebound was due in it (``rebounds_due``): their rebounds are taken to
-        have landed there (``rebounds.hidden_rebound``), so that each one's own rebound can be recognised."""
+                 due: list[PulseSummary] | tuple = ()) -> dict:
+        """The rest of a contact's report: the rebound decision, the fit restated, the class.  ``due``: the earlier
+        contacts whose rebound was due in it (``rebounds_due``; none for a piece of a split).  In an overlap
+        their rebounds are taken to have landed there (``rebounds.hidden_rebound``), so that each one's own
+        rebound can be recognised; a single pulse judged a new fruit may be one and a due rebound landing
+        together (``rebounds.landed_with_rebound``): then it is an overlap too."""
         analysis = self.analysis
         sequence = self._sequence.get(impact.lane, 0)
         self._sequence[impact.lane] = sequence + 1
@@ -351,6 +354,13 @@ class LineAnalyzer:
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
+        together = landed_with_rebound(summary, list(due), self._fruit.get(impact.lane, [])) \
+            if not rebound and status == "ok" and summary is not None and due else None
+        if together is not None:  # one fruit fitted through two pulses would be a wrong grade: no firmness
+            status, chosen, summary = "overlap", None, None
+            message = f"a fruit and a rebound landing together: {together['reason']}; no firmness"
+            for key in FIRMNESS_KEYS:
+                report[key] = math.nan
         speed = analysis.velocity
         if rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
@@ -364,7 +374,7 @@ class LineAnalyzer:
                 else None
         report.update(rebound=rebound, rebound_of=chosen.parent if rebound else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous),
-                      rebound_evidence=chosen.evidence if chosen is not None else None)
+                      rebound_evidence=chosen.evidence if chosen is not None else together)
         if analysis.fit and shape is not None and status != "overlap":
             result = _restated(shape, analysis, speed)
             _merge_fit(report, result)
@@ -385,7 +395,7 @@ class LineAnalyzer:
         if status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
-            likeliest = likeliest_hidden(list(hidden), report["start_time"])
+            likeliest = likeliest_hidden(list(due), report["start_time"])
             if likeliest is not None:  # at most one rebound hides in an overlap: the one due nearest its onset
                 history.append(hidden_rebound(likeliest, sequence, report["start_time"]))
         elif summary is not None and not rebound and summary.refined:

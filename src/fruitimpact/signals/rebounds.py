@@ -58,6 +58,7 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
+           "landed_with_rebound",
            "likeliest_hidden",
            "judge_unmeasured",
            "rebounds_due", "refine", "shape_table"]
@@ -410,6 +411,57 @@ LANE_FRUIT_MIN = 5
 def _robust_sd(values) -> float:
     values = np.asarray(values, dtype=float)
     return float(1.4826 * np.median(np.abs(values - np.median(values))))
+
+
+#: Least spread (sd of ln) of the impulse of a lane's fruit that ``landed_with_rebound`` assumes: fruit of one
+#: lot differ in mass by 10–15 % (sd) and a lane's first few measured fruit understate that (5 fruit gave 5 %,
+#: and a fruit 1.3 times their median then looked like a fruit and a rebound together).
+LOT_IMPULSE_SD = 0.15
+
+
+def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit: list[PulseSummary]) -> dict | None:
+    """Is ``candidate``, one pulse judged no rebound, a new fruit and a due rebound that landed together?
+
+    Two pulses starting within a fraction of a millisecond add up to one pulse that a single force law fits to
+    the noise (no joint fit can part them), and its fit is one fruit of about the sum of their masses and
+    stiffnesses: a wrong grade.  What betrays them is what they carry: the impulse m (1 + e) V of a fruit of the
+    lane (the median and robust spread, at least ``LOT_IMPULSE_SD``, of its measured ``fruit``, at least
+    ``LANE_FRUIT_MIN``) plus that of the
+    rebound that was ``due`` (``rebounds_due``): the same fruit as its parent at r V_p, r = ``EXPECTED_RATIO``
+    e_p, so I_p r (1 + e_r)/(1 + e_p) ± ``EXPECTED_RATIO_SD``.  They landed together when the impulse lies more
+    than ``TOLERANCES["z"]`` sd above the lane's fruit (a fruit that heavy is improbable) and nearer, in sd, to
+    a fruit and that rebound together.  Returns the evidence (the parent whose rebound it holds, both distances)
+    or None."""
+    if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or not due:
+        return None
+    z = TOLERANCES["z"]
+    log_impulse = np.log([f.impulse for f in fruit])
+    impulse_lane = float(np.exp(np.median(log_impulse)))
+    impulse_sd = max(_robust_sd(log_impulse), LOT_IMPULSE_SD)
+    fruit_distance = math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)
+    if not fruit_distance > z:
+        return None
+    best = None
+    for parent in due:
+        r = EXPECTED_RATIO * parent.restitution
+        rebound_impulse = parent.impulse * r * (1.0 + _at("e", r * parent.x)) / (1.0 + parent.restitution)
+        both = impulse_lane + rebound_impulse
+        both_sd = math.hypot(impulse_lane * impulse_sd, rebound_impulse * EXPECTED_RATIO_SD) / both
+        distance = abs(math.log(candidate.impulse / both)) / math.hypot(both_sd, candidate.impulse_sd)
+        if best is None or distance < best["together_distance"]:
+            best = {"landed_with_rebound_of": parent.sequence, "impulse": candidate.impulse,
+                    "lane_fruit_impulse": impulse_lane, "rebound_impulse_predicted": rebound_impulse,
+                    "lane_fruit": len(fruit), "fruit_distance": round(fruit_distance, 3),
+                    "together_distance": distance}
+    if not (best["together_distance"] < fruit_distance and best["together_distance"] <= z):
+        return None
+    best["together_distance"] = round(best["together_distance"], 3)
+    best["reason"] = (f"one pulse carrying {candidate.impulse / impulse_lane:.2f} times the impulse of the lane's "
+                      f"{len(fruit)} measured fruit ({fruit_distance:.1f} sd above them) where the rebound of "
+                      f"#{best['landed_with_rebound_of']} was due; a fruit and that rebound together carry "
+                      f"{(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
+                      f"({best['together_distance']:.1f} sd)")
+    return best
 
 
 def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, fruit: list[PulseSummary],
