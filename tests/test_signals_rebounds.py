@@ -490,3 +490,42 @@ def test_the_rebound_of_a_fruit_hidden_in_an_overlap_reports_its_pulse_without_m
     assert rebound["peak_force"] == pytest.approx(back["F"], rel=0.01)
     assert rebound["time_to_peak"] == pytest.approx(back["tc"], rel=0.02)
     assert rebound["restitution"] == pytest.approx(back["e"], abs=0.03)
+
+
+def _lane_then_fruit_with_rebound(seed, next_mass=1.0, with_rebound=True, gap=5e-5):
+    """Six measured fruit of a lot (masses ±10 %), a seventh whose rebound is due 2 e V/g after it leaves, and a
+    new fruit landing ``gap`` [s] before that rebound (or alone, ``with_rebound=False``: a pad caught it)."""
+    rng = np.random.default_rng(seed)
+    fruit = [impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=rng.uniform(0.55, 0.6)) for _ in range(7)]
+    last = fruit[-1]
+    back = impact(mass=last["m"], velocity=last["e"] * V_LINE, c=last["c"])
+    landing = 0.7 + last["T"] + 2 * last["e"] * V_LINE / G
+    new = impact(mass=next_mass * MASS, restitution=0.57)
+    onsets, impacts = [0.1 + 0.1 * k for k in range(7)] + [landing - gap], [*fruit, new]
+    if with_rebound:
+        onsets, impacts = onsets + [landing], impacts + [back]
+    x = _signal(onsets, impacts, int(0.95 * RATE), seed=seed)
+    # noise of a line (2.2 % of the peak in all): it hides the misfit of the summed pulse, as hum and ringing did
+    return new, x + np.random.default_rng(100 + seed).normal(0.0, 0.02 * fruit[0]["F"], x.size)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_fruit_and_a_rebound_landing_within_a_tenth_of_a_millisecond_are_an_overlap(seed):
+    """A new fruit and the previous fruit's rebound landing 0.05 ms apart add up to one pulse that one force law
+    fits to the noise of a line (2.2 % of the peak here; at 1 % the joint fit still finds two pulses, which it
+    cannot part: an overlap too); fitted as one fruit it has about the summed mass and
+    stiffness, a wrong grade (seen on tests/linegen.py's chain10: stiffness 56 % off, status ok).  Its impulse
+    betrays it: ~1.6 times the lane's fruit, beyond 3 sd of a lot (mass spread at least 15 %,
+    rebounds.LOT_IMPULSE_SD) and near a fruit and that rebound together (rebounds.landed_with_rebound): one
+    overlap, no firmness, with the evidence.  The same fruit alone (its rebound caught by a pad), or a fruit 1.3
+    times the lot's mass where the rebound was due, is one fruit: measured, not flagged."""
+    new, x = _lane_then_fruit_with_rebound(seed)
+    report = _reports(x)[-1]
+    assert report["status"] == "overlap" and "a fruit and a rebound landing together" in report["message"]
+    assert math.isnan(report["firmness_c"]) and report.get("stiffness") is None
+    assert report["rebound_evidence"]["landed_with_rebound_of"] == 6
+    for alone in (_lane_then_fruit_with_rebound(seed, with_rebound=False)[1],
+                  _lane_then_fruit_with_rebound(seed, next_mass=1.3, with_rebound=False)[1]):
+        report = _reports(alone)[-1]
+        assert report["status"] == "ok" and not report["rebound"], report["message"]
+        assert not math.isnan(report["firmness_c"])
