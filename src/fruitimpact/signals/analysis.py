@@ -337,6 +337,11 @@ class LineAnalyzer:
         summary = None
         if status in ("ok", "clipped"):
             summary = from_indices(report, sequence, impact.noise, None)
+            if summary is None and shape is not None and shape.get("converged"):
+                # an index the samples did not give (a weak rebound's falling edge lost in the noise): the fitted
+                # pulse's own (without it the contact could not be judged at all, and was taken for a new fruit)
+                summary = from_indices({**report, **{key: shape.get(key) for key in SUMMARY_KEYS}}, sequence,
+                                       impact.noise, None)
             if summary is not None:
                 summary = refine(summary, shape)
         history = self._history.setdefault(impact.lane, [])
@@ -534,6 +539,8 @@ def _status(impact: DetectedImpact) -> tuple[str, str]:
     return "ok", ""
 
 
+#: Indices a rebound test reads (``rebounds.from_indices``).
+SUMMARY_KEYS = ("start_time", "peak_force", "time_to_peak", "impulse")
 #: Indices the fit restates (the measured ones kept as ``raw_<key>``).
 RESTATED_KEYS = ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c", "firmness_c_star",
                  "impulse")
