@@ -946,3 +946,25 @@ def test_docstrings_say_the_susceptibility_is_the_median():
     assert "BS is therefore the **median** volume per" in fitting.__doc__
     assert "median volume per joule" in fitting.fit_volumes.__doc__
     assert "the median volume per joule above a fruit's threshold" in fi.fit_damage.__doc__
+
+
+def test_a_quoted_field_over_several_lines_is_one_field(tmp_path):
+    """A spreadsheet cell holding line breaks (Alt+Enter) is exported as one quoted field spanning lines (RFC 4180);
+    a blank line or one starting with # inside it is part of the field, not a blank or comment line.  The shared
+    reader (library.textfiles) keeps such a record whole, with the number of its first line."""
+    from fruitimpact.library.textfiles import table_lines
+
+    path = tmp_path / "t.csv"
+    path.write_text('a,b\n# a comment\n1,"x\n\n# not a comment\ny"\n\n2,"q""r"\n')
+    assert table_lines(path) == [(1, "a,b\n"), (3, '1,"x\n\n# not a comment\ny"\n'), (8, '2,"q""r"\n')]
+    apple = catalogue.fruit("apple")
+    text = catalogue.fruit_file_text(apple)
+    header, row = text.rstrip("\n").split("\n")[-2:]
+    assert row.startswith("apple,")
+    # the description of the library apple, written over three lines in a quoted cell
+    multi = text.replace(row, row.replace("apple,", 'apple,"a firm dessert apple\n\n# of several cultivars",', 1)
+                         .replace(',generic firm dessert apple (Golden Delicious/Jonagold-like size); values pooled from '
+                                  'several cultivars and studies', '', 1))
+    (tmp_path / "mine.csv").write_text(multi)
+    entry = catalogue.read_fruit_file(tmp_path / "mine.csv")
+    assert entry.description == "a firm dessert apple\n\n# of several cultivars"

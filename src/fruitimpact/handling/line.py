@@ -71,7 +71,7 @@ def read_line(path) -> list[TransferPoint]:
     import csv
     import os
 
-    from fruitimpact.impact.textfiles import table_lines
+    from fruitimpact.library.textfiles import table_lines
     from fruitimpact.impact.units import parse_quantity
 
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed

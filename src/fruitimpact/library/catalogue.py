@@ -37,6 +37,8 @@ from dataclasses import dataclass, fields
 from importlib import resources
 from types import MappingProxyType
 
+from fruitimpact.library.textfiles import table_lines
+
 __all__ = ["ENERGY_BASED", "FILE_CHECKS", "ENERGY_BASES", "FITTED_BY", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS",
            "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion", "fruit",
            "fruit_file_text", "fruit_rows", "fruits", "is_fruit_file", "load_fruit_file",
@@ -436,12 +438,9 @@ def read_fruit_file(path) -> Fruit:
         raise LibraryError(f"the fruit file {shown!r} is a directory, not a fruit file (a .csv in the fruit "
                            f"library's format)")
     try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
-            lines = [line for line in handle if line.strip() and not line.lstrip().startswith("#")]
-    except OSError as exc:
-        raise LibraryError(f"cannot read the fruit file {shown!r}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise LibraryError(f"cannot read the fruit file {shown!r}: not a UTF-8 text file") from None
+        lines = [line for _, line in table_lines(path, name=f"the fruit file {shown!r}")]
+    except ValueError as exc:
+        raise LibraryError(str(exc)) from None
     rows = list(csv.reader(lines))
     if not rows:
         raise LibraryError(f"fruit file {shown!r} is empty: expected the header of the fruit library (fruits.csv)")

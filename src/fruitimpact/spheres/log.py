@@ -136,7 +136,7 @@ def _cell(text: str, dimension: str, factor: float) -> float:
 def _table(path, mapping: dict, schema: dict, hint: str = "; map a vendor's headers with --columns name=Header"):
     """(our name of each header cell, unit factors, data rows with their line numbers); ``mapping`` as
     ``parse_columns`` returns it; ``hint`` ends the message of an unknown column."""
-    from fruitimpact.impact.textfiles import table_lines
+    from fruitimpact.library.textfiles import table_lines
 
     lines = table_lines(path)
     if not lines:

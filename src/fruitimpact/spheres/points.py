@@ -57,7 +57,7 @@ def read_windows(path) -> list[tuple[str, float, float]]:
     ``ValueError`` naming the file, line and column."""
     import csv
 
-    from fruitimpact.impact.textfiles import table_lines
+    from fruitimpact.library.textfiles import table_lines
     from fruitimpact.impact.units import parse_quantity
 
     lines = table_lines(path, "points: ")

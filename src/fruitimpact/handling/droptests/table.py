@@ -116,7 +116,7 @@ def _table(tests):
     if isinstance(tests, (str, os.PathLike)):
         import csv
 
-        from fruitimpact.impact.textfiles import table_lines
+        from fruitimpact.library.textfiles import table_lines
 
         label = os.fspath(tests)
         try:
