@@ -28,6 +28,7 @@ from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_L
 from fruitimpact.impact.outputs import json_safe
 from fruitimpact.impact.quantities import option_of
 from fruitimpact.impact.validation import InputError, read_count, usage_message
+from fruitimpact.library.textfiles import yes_or_no
 
 #: The file the page's line is saved as, and the name its command and its messages give it.
 LINE_FILE = "line.csv"
@@ -52,7 +53,6 @@ LOT_INPUTS = ("fruit", "criterion", "mass", "diameter", "modulus", "failure_stre
 #: Every name a request may hold.
 REQUEST_NAMES = ("points", *LOT_INPUTS, "rows", "seed", "spreads", "alternatives", "what_if")
 #: Texts of a line CSV's ``fruit_on_fruit`` column (``read_line``'s).
-_TRUE_TEXTS, _FALSE_TEXTS = {"true", "yes", "1", "y"}, {"false", "no", "0", "n", ""}
 #: z of a two-sided 95 % interval.
 _Z95 = 1.959963984540054
 
@@ -122,10 +122,10 @@ def read_points(points) -> tuple[list[TransferPoint], list[dict]]:
             raise refused(f"{where}: name must be one line of text; got {cells['name']!r}", "name")
         flag = row.get("fruit_on_fruit", False)
         if not isinstance(flag, bool):
-            text = flag.strip().lower() if isinstance(flag, str) else None
-            if text not in _TRUE_TEXTS | _FALSE_TEXTS:
+            answer = yes_or_no(flag, blank=False) if isinstance(flag, str) else None
+            if answer is None:
                 raise refused(f"{where}: fruit_on_fruit must be true or false; got {flag!r}", "fruit_on_fruit")
-            flag = text in _TRUE_TEXTS
+            flag = answer
         try:
             height = parse_quantity(cells["drop_height"], "length")
         except ValueError as error:

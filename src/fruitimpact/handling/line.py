@@ -21,9 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fruitimpact.library.textfiles import table_lines, yes_or_no
+
 #: Columns of a line table; ``fruit_on_fruit`` is optional.
 LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit")
-_TRUE, _FALSE = {"true", "yes", "1", "y"}, {"false", "no", "0", "n", ""}
 #: Transfer points of a line at most.
 MAX_POINTS = 200
 
@@ -71,7 +72,6 @@ def read_line(path) -> list[TransferPoint]:
     import csv
     import os
 
-    from fruitimpact.library.textfiles import table_lines
     from fruitimpact.impact.units import parse_quantity
 
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
@@ -101,10 +101,10 @@ def read_line(path) -> list[TransferPoint]:
             height = parse_quantity(cells["drop_height"], "length")
         except ValueError as exc:
             raise ValueError(f"{where}: drop_height: {exc}") from None
-        flag = cells.get("fruit_on_fruit", "").lower()
-        if flag not in _TRUE | _FALSE:
+        flag = yes_or_no(cells.get("fruit_on_fruit", ""), blank=False)
+        if flag is None:
             raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
-        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag in _TRUE), where))
+        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag), where))
     return _distinct(points, str(path))
 
 

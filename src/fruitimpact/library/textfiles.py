@@ -56,4 +56,17 @@ def _records(numbered) -> list[tuple[int, str]]:
     return records
 
 
-__all__ = ["table_lines"]
+#: The words a cell of a hand-written table may say yes or no with (case and surrounding blanks ignored).
+YES_WORDS, NO_WORDS = frozenset({"true", "yes", "y", "1"}), frozenset({"false", "no", "n", "0"})
+
+
+def yes_or_no(text: str, blank: bool | None = None) -> bool | None:
+    """True or False for a yes/no word of ``YES_WORDS`` or ``NO_WORDS`` in ``text``; ``blank`` for an empty
+    cell; None for anything else (the caller refuses it, naming its column)."""
+    word = text.strip().lower()
+    if not word:
+        return blank
+    return True if word in YES_WORDS else False if word in NO_WORDS else None
+
+
+__all__ = ["NO_WORDS", "YES_WORDS", "table_lines", "yes_or_no"]

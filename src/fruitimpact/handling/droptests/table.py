@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fruitimpact.library.textfiles import table_lines, yes_or_no
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 
@@ -31,7 +32,6 @@ RANGE_SIGMAS = 2.0
 #: Test masses whose median differs from the fruit's by more than this share are said to (the failure stress uses
 #: the fruit's own mass and size).
 MASS_MISMATCH = 0.25
-_TRUE, _FALSE = {"1", "true", "yes", "y"}, {"0", "false", "no", "n"}
 #: The standard normal's 97.5 % point: a 95 % interval is ±1.96 standard errors.
 _Z95 = 1.959963984540054
 #: What the failure stress's interval holds, and what it does not.
@@ -116,8 +116,6 @@ def _table(tests):
     if isinstance(tests, (str, os.PathLike)):
         import csv
 
-        from fruitimpact.library.textfiles import table_lines
-
         label = os.fspath(tests)
         try:
             numbered = table_lines(tests)
@@ -187,8 +185,9 @@ def _flag(cell) -> float:
     if isinstance(cell, bool):
         return float(cell)
     text = str(cell).strip().lower()
-    if text in _TRUE or text in _FALSE:
-        return 1.0 if text in _TRUE else 0.0
+    answer = yes_or_no(text)
+    if answer is not None:
+        return float(answer)
     try:  # 1, 0, 1.0, "1.0", "0.0": read as numbers are
         number = float(cell if not isinstance(cell, str) else text)
     except (TypeError, ValueError):
