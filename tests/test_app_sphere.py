@@ -291,3 +291,39 @@ def test_a_sphere_log_in_place_of_the_table_in_a_real_browser(server, tmp_path, 
         _wait(view, f"window.fruitimpact.updates > {updates}")
         assert view.evaluate("window.fruitimpact.last.report.points[2].drop_height") == pytest.approx(0.02)
         view.screenshot(path=str(shots / "table-1400.png"))
+
+
+def test_a_failed_audit_says_so_in_its_headline_in_a_real_browser(server, tmp_path):
+    """A log whose last transfer point holds only a reading no impact reproduces (40 m/s: an 80 m drop) is a failed
+    audit (``sphere_audit``'s status): the verdict at the top of the results says "failed" and why before the share
+    bruised, which counts only the points computed, and its frame turns red; an audit that is ok shows no such
+    line (the example log)."""
+    shots = Path(os.environ.get("FRUITIMPACT_SCREENSHOTS", tmp_path))
+    shots.mkdir(parents=True, exist_ok=True)
+    bad = tmp_path / "cannon-log.csv"
+    bad.write_text((EXAMPLES / LOG).read_text() + "400.000,900,40,0.0005,cannon\n")
+    with browser_page(server) as view:
+        view.goto(server + "line")
+        _wait(view, "window.fruitimpact.updates >= 1")
+        view.check("input[name=source][value=sphere]")
+        view.select_option("select[name=sphere]", "is-1987")
+        view.fill("input[name=logger_rate]", "3kHz")
+        view.set_input_files("#sphere-calibration", str(EXAMPLES / CALIBRATION))
+        view.set_input_files("#sphere-log", str(EXAMPLES / LOG))
+        _wait(view, "window.fruitimpact.sphere !== null && window.fruitimpact.sphere.calibration_file !== null "
+                    "&& window.fruitimpact.sphere.request.logger_rate === '3kHz'", 120)
+        assert view.evaluate("window.fruitimpact.sphere.report.status") == "ok"
+        assert view.locator("#sphere-verdict-status").count() == 0
+        assert "not-ok" not in view.get_attribute("#sphere-verdict", "class")
+        count = view.evaluate("window.fruitimpact.sphereUpdates")
+        view.set_input_files("#sphere-log", str(bad))
+        _wait(view, f"window.fruitimpact.sphereUpdates > {count} && window.fruitimpact.sphere.file === 'cannon-log.csv'",
+              120)
+        report = view.evaluate("window.fruitimpact.sphere.report")
+        assert report["status"] == "failed"
+        headline = view.text_content("#sphere-verdict-status")
+        assert headline.startswith("the audit is not ok") and f"failed: {report['message']}" in headline
+        assert view.is_visible("#sphere-verdict-status")
+        assert "not-ok" in view.get_attribute("#sphere-verdict", "class")
+        assert "of the points computed" in view.text_content("#sphere-verdict")
+        view.locator("#sphere-verdict").screenshot(path=str(shots / "sphere-failed-verdict.png"))

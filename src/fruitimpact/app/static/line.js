@@ -300,9 +300,13 @@ function lotText(report) {
 // The verdict in `box`: the share of the lot bruised on the line (`lotLabel`: how it was drawn; `interval`: its
 // 95 % interval, or null), the mean bruise volume per fruit and the most harmful point (`worst`: its name, or null,
 // and `detail`). Its figures' ids start with `prefix`.
-function verdict(box, prefix, {lotLabel, incidence, interval, volume, worst, detail}) {
-  box.replaceChildren(
-    item(`bruised on the line (${lotLabel})`, [
+function verdict(box, prefix, {lotLabel, incidence, interval, volume, worst, detail, status = "ok", message = ""}) {
+  // an audit that is not ok says so first, in the headline, not only in the notes under the tables
+  const failed = status === "ok" ? [] : [make("div", {className: "item failed-headline", id: `${prefix}verdict-status`}, [
+    make("span", {textContent: "the audit is not ok"}), make("b", {}, [`${status}: ${message}`])])];
+  box.classList.toggle("not-ok", status !== "ok");
+  box.replaceChildren(...failed,
+    item(`bruised on the line (${lotLabel})${status === "ok" ? "" : " — of the points computed"}`, [
       make("strong", {className: "big", id: `${prefix}verdict-incidence`, textContent: percent(incidence)}),
       make("small", {className: "interval", textContent: interval ? ` (95 %: ${percent(interval[0])} to ${percent(interval[1])})` : ""})]),
     item("mean bruise volume per fruit", mm3(volume), `${prefix}verdict-volume`),
@@ -316,6 +320,7 @@ function renderVerdict(answer, worst) {
   const point = report.points[worst];
   const onto = point && (point.fruit_on_fruit ? "onto fruit" : `onto ${point.surface}`);
   verdict(document.getElementById("verdict"), "", {
+    status: report.status, message: report.message,
     lotLabel: `criterion ${report.criterion}, ${lotText(report)}`, incidence: report.incidence,
     interval: answer.incidence_interval, volume: report.mean_bruise_volume, worst: point ? point.name : null,
     detail: point && `${fmt(point.drop_height * 100, 3)} cm ${onto}: ${percent(point.incidence)} bruised there, ${mm3(point.mean_bruise_volume)}`});
@@ -448,6 +453,7 @@ function renderSphere(answer) {
   const point = report.points[worst];
   const surface = point && (point.surface_modulus === null ? `a rigid surface (${point.surface})` : `${fmt(point.surface_modulus / 1e6, 3)} MPa (nearest ${point.surface})`);
   verdict(document.getElementById("sphere-verdict"), "sphere-", {
+    status: report.status, message: report.message,
     lotLabel: `criterion ${report.criterion}, ${report.rows.toLocaleString("en-US")} fruit, seed ${report.seed}`,
     incidence: report.incidence, interval: null, volume: report.mean_bruise_volume, worst: point ? point.name : null,
     detail: point && `${fmt(point.drop_height * 100, 3)} cm onto ${surface}: ${percent(point.incidence)} bruised there, ${mm3(point.bruise_volume)}`});
