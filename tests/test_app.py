@@ -18,6 +18,7 @@ import subprocess
 import time
 import urllib.error
 import urllib.request
+from pathlib import Path
 
 import pytest
 
@@ -189,6 +190,8 @@ def _cell(page, name: str) -> float:
 
 
 def test_the_explorer_in_a_real_browser(server, tmp_path):
+    shots = Path(os.environ.get("FRUITIMPACT_SCREENSHOTS", tmp_path))
+    shots.mkdir(parents=True, exist_ok=True)
     with browser_page(server) as page:
         page.goto(server)
         _wait(page, "window.fruitimpact.updates >= 1")
@@ -234,6 +237,11 @@ def test_the_explorer_in_a_real_browser(server, tmp_path):
         # the risk map and an export
         page.click("#risk-button")
         page.wait_for_selector("#chart-risk rect")
+        # its colour key: the share bruised from 0 % to 100 %, beside the map
+        assert page.eval_on_selector_all("#chart-risk g[data-part=key] text", "ts => ts.map(t => t.textContent)") == \
+            ["0 %", "50 %", "100 %", "bruised"]
+        assert page.locator("#chart-risk g[data-part=key] rect").count() == 41
+        page.locator("#chart-risk").screenshot(path=str(shots / "risk-map.png"))
         with page.expect_download() as download:
             page.click("[data-export=csv]")
         lines = (download.value.path().read_text() if hasattr(download.value.path(), "read_text")

@@ -98,7 +98,7 @@ const Charts = (() => {
   // A heat map: rows × columns of values (NaN/null blank), diverging at 0 (green below, red at and above).
   function heat(svg, spec) {
     const f = frame(svg);
-    f.left = 64; f.bottom = 54;
+    f.left = 64; f.bottom = 54; f.right = 74;  // the right margin holds the colour key
     const W = f.width - f.left - f.right, H = f.height - f.top - f.bottom;
     const cols = spec.columns.length, rows = spec.rows.length;
     const cw = W / cols, rh = H / rows;
@@ -127,6 +127,23 @@ const Charts = (() => {
     spec.rowTicks.forEach(([r, label]) => {
       el("text", {x: f.left - 6, y: f.top + H - r * rh + 4, "text-anchor": "end"}, svg).textContent = label;
     });
+    // the colour key: what a cell's colour says (a share bruised from 0 to 1, or a margin from -1 to 1), in
+    // steps drawn as rectangles so that an exported SVG or PNG carries it as drawn
+    const key = el("g", {"data-part": "key"}, svg);  // (el's "class" is a preset style, not an attribute)
+    const low = spec.share ? 0 : -1, steps = 40, kx = f.left + W + 16, kw = 12;
+    for (let i = 0; i < steps; i += 1) {
+      const v = low + (1 - low) * (i + 0.5) / steps;
+      el("rect", {x: kx, y: f.top + H - (i + 1) * H / steps, width: kw, height: H / steps + 0.5, fill: color(v)}, key);
+    }
+    el("rect", {x: kx, y: f.top, width: kw, height: H, fill: "none", stroke: "#9aa3ad", "stroke-width": 0.5}, key);
+    const marks = spec.share ? [[0, "0 %"], [0.5, "50 %"], [1, "100 %"]] : [[-1, "−1"], [0, "0"], [1, "1"]];
+    for (const [v, label] of marks) {
+      const y = f.top + H - (v - low) / (1 - low) * H;
+      el("line", {x1: kx + kw, x2: kx + kw + 4, y1: y, y2: y, stroke: "#5b6672"}, key);
+      el("text", {x: kx + kw + 6, y: y + 4, "text-anchor": "start"}, key).textContent = label;
+    }
+    el("text", {x: kx, y: f.top + H + 14, "text-anchor": "start"}, key).textContent =
+      spec.share ? "bruised" : "margin";
     el("text", {x: f.left + W / 2, y: f.height - 8, "text-anchor": "middle", class: "label"}, svg).textContent = spec.xLabel;
     el("text", {x: 14, y: f.top + H / 2, "text-anchor": "middle", class: "label", transform: `rotate(-90 14 ${f.top + H / 2})`}, svg).textContent = spec.yLabel;
   }
