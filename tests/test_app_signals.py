@@ -363,6 +363,10 @@ def test_the_monitor_in_a_real_browser_keeps_up_with_four_lanes(server, line_rec
         assert int(page.text_content("#contacts").replace(",", "")) == contacts
         assert page.locator(".lane").count() == 4
         assert "(all)" in page.text_content("#messages")
+        # news in the ink colour, not a problem's: the summary of a stream whose every report arrived
+        summary = page.locator("#messages li", has_text="(all)")
+        assert summary.get_attribute("class") in (None, "")
+        assert page.evaluate("getComputedStyle(document.querySelector('#messages li')).color") == "rgb(29, 38, 48)"
 
 
 def test_a_reset_connection_ends_one_client_and_the_monitor_takes_the_next(server):

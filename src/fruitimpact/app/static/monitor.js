@@ -75,6 +75,8 @@ function stop() {
   statusLine.textContent = "stopping: the detector flushes its last contacts…";
 }
 
+// A line of the stream's log: plain for news (a client, the summary when every report arrived), coloured for a
+// problem (warn) or an error (bad).
 function note(text, kind) {
   const item = document.createElement("li");
   item.textContent = text;
@@ -142,11 +144,12 @@ function frame(message) {
   for (const item of message.messages) {
     if (item.type === "summary") {
       window.fruitimpact.summaries.push(item.summary);
+      const all = state.contacts === window.fruitimpact.summaries.reduce((s, x) => s + x.impacts, 0);
       note(`the stream reported ${item.summary.impacts} contacts in ${item.summary.samples.toLocaleString("en-US")} samples per lane` +
            (item.dropped ? `; ${item.dropped} samples dropped` : "") + "; this page received " + state.contacts +
-           (state.contacts === window.fruitimpact.summaries.reduce((s, x) => s + x.impacts, 0) ? " (all)" : " (MISSING SOME)"));
+           (all ? " (all)" : " (MISSING SOME)"), all && !item.dropped ? "" : "problem");
     } else if (item.type === "client") note(`client ${item.client} connected from ${item.address}`);
-    else note(item.message, item.type === "error" ? "error" : "");
+    else note(item.message, item.type === "error" ? "error" : "problem");  // the stream's problems and errors
   }
   state.figures = message.figures;
   window.fruitimpact.contacts = state.contacts;
