@@ -546,3 +546,39 @@ def test_a_weak_rebound_whose_falling_edge_is_lost_in_the_noise_is_judged_on_its
     assert math.isnan(second["raw_impulse"])  # the premise: the samples alone give no impulse
     assert second["status"] == "ok" and second["rebound"] and second["rebound_of"] == first["sequence"]
     assert second["impulse"] == pytest.approx(back["impulse"], rel=0.05)
+
+
+def _two_rebounds_due(seed, landing_pulses):
+    """Six measured fruit (e 0.55–0.60, masses ±10 %), then fruit A (e 0.6) and fruit B (e 0.5, 20 ms later) whose
+    rebounds are due at the same moment; ``landing_pulses(a, b, landing)`` gives the (onsets, impacts) that land
+    then.  The line's noise as in ``_lane_then_fruit_with_rebound``."""
+    rng = np.random.default_rng(seed)
+    fruit = [impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=rng.uniform(0.55, 0.6)) for _ in range(6)]
+    a, b = impact(restitution=0.6), impact(mass=0.95 * MASS, restitution=0.5)
+    landing = 0.7 + a["T"] + 2 * a["e"] * V_LINE / G
+    onset_b = landing - b["T"] - 2 * b["e"] * V_LINE / G + 5e-5
+    onsets, impacts = landing_pulses(a, b, landing)
+    x = _signal([0.1 + 0.1 * k for k in range(6)] + [0.7, onset_b, *onsets], [*fruit, a, b, *impacts],
+                int(0.95 * RATE), seed=seed)
+    return x + np.random.default_rng(100 + seed).normal(0.0, 0.02 * fruit[0]["F"], x.size)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_two_rebounds_landing_together_are_no_fruit(seed):
+    """A's rebound and B's land 0.05 ms apart: one pulse that a single force law fits, which the rebound test of
+    either parent alone rejects (it carries both impulses) and which had been reported as a new fruit, graded.
+    It carries what the two rebounds carry together, the impulse of each (the same fruit at 0.92 e V) added and a
+    rebound's restitution (0.7 against the lane's 0.58: a slower impact), where a new fruit of the lane lies far
+    (rebounds.rebounds_landed_together): one overlap report, a rebound, no firmness, both parents in its evidence.
+    A typical new fruit landing there alone (its e and mass the lane's, or 1.3 times the mass) is a new fruit."""
+    def rebounds(a, b, landing):
+        return [landing, landing + 5e-5], [impact(mass=a["m"], velocity=a["e"] * V_LINE, c=a["c"]),
+                                           impact(mass=b["m"], velocity=b["e"] * V_LINE, c=b["c"])]
+    *_, first, second, both = _reports(_two_rebounds_due(seed, rebounds))
+    assert both["status"] == "overlap" and both["message"].startswith("two rebounds landing together")
+    assert both["rebound"] and math.isnan(both["firmness_c"]) and both.get("class") is None
+    assert sorted(both["rebound_evidence"]["parents"]) == [first["sequence"], second["sequence"]]
+    for mass in (1.0, 1.3):
+        new = _reports(_two_rebounds_due(seed, lambda a, b, landing: ([landing], [impact(mass=mass * MASS,
+                                                                                         restitution=0.58)])))[-1]
+        assert new["status"] == "ok" and not new["rebound"], new["message"]

@@ -44,6 +44,7 @@ from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
                                          hidden_rebound, judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
+                                         rebounds_landed_together,
                                          rebounds_due,
                                          refine, shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
@@ -359,27 +360,36 @@ class LineAnalyzer:
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
-        together = landed_with_rebound(summary, list(due), self._fruit.get(impact.lane, [])) \
-            if not rebound and status == "ok" and summary is not None and due else None
+        together = pair = None
+        if not rebound and status == "ok" and summary is not None and due:
+            lane_fruit = self._fruit.get(impact.lane, [])
+            together = landed_with_rebound(summary, list(due), lane_fruit)
+            pair = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
         if together is not None:  # one fruit fitted through two pulses would be a wrong grade: no firmness
             status, chosen, summary = "overlap", None, None
             message = f"a fruit and a rebound landing together: {together['reason']}; no firmness"
+            for key in FIRMNESS_KEYS:
+                report[key] = math.nan
+        elif pair is not None:  # no fruit at all: two rebounds, each of its own parent
+            status, chosen, summary, rebound = "overlap", None, None, True
+            message = f"two rebounds landing together: {pair['reason']}; no firmness"
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
         speed = analysis.velocity
         if rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
-        elif rebound:
+        elif rebound and chosen is not None:
             index = next(i for i, s in enumerate(history) if s.sequence == chosen.parent)
             parent = history[index]
             history[index] = parent.taken()
             # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
             speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
                 else None
-        report.update(rebound=rebound, rebound_of=chosen.parent if rebound else None,
+        report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound else
+                      pair["parents"][0] if pair is not None else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous),
-                      rebound_evidence=chosen.evidence if chosen is not None else together)
+                      rebound_evidence=chosen.evidence if chosen is not None else together or pair)
         if analysis.fit and shape is not None and status != "overlap":
             result = _restated(shape, analysis, speed)
             _merge_fit(report, result)
@@ -397,7 +407,12 @@ class LineAnalyzer:
             history[:] = recent[-8:]
         if not rebound and status != "overlap":
             self._last_fruit[impact.lane] = report["start_time"]
-        if status == "overlap":
+        if pair is not None:  # both rebounds are seen, and each may bounce again from here
+            for index, parent in enumerate(list(history)):
+                if parent.sequence in pair["parents"]:
+                    history[index] = parent.taken()
+                    history.append(hidden_rebound(parent, sequence, report["start_time"]))
+        elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
             likeliest = likeliest_hidden(list(due), report["start_time"])

@@ -58,7 +58,7 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
-           "landed_with_rebound",
+           "landed_with_rebound", "rebounds_landed_together",
            "likeliest_hidden",
            "judge_unmeasured",
            "rebounds_due", "refine", "shape_table"]
@@ -462,6 +462,78 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
                       f"{(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
                       f"({best['together_distance']:.1f} sd)")
     return best
+
+
+#: Least spread of the restitution of a lane's fruit and of a predicted rebound's (``rebounds_landed_together``).
+LOT_RESTITUTION_SD = 0.02
+#: Two due rebounds are taken to have landed together when the pulse lies within this distance (in sd, impulse and
+#: restitution together) of what the two carry, and a new fruit of the lane lies ``PAIR_MARGIN`` times farther.
+#: Chosen on 36 line recordings of tests/linegen.py (chain10, grades, close, lanes4, chain7, noisy at seeds 1–6):
+#: the 4 contacts that were two rebounds lay at 0.93–1.17 sd from the pair and 1.9–3.1 times farther from a new
+#: fruit; the nearest new fruit lay at 1.97 sd, two lone rebounds at 1.28 and 1.48.  Few cases: the margin is thin,
+#: and a lively new fruit taken for two rebounds loses its grade (an overlap), where two rebounds taken for a
+#: fruit are a fruit that never was, graded.
+PAIR_DISTANCE_MAX, PAIR_MARGIN = 1.25, 1.5
+
+
+def _rebound_pulse(parent: PulseSummary) -> tuple[float, float, float]:
+    """(impulse [N s], restitution, its sd) of ``parent``'s rebound: the same fruit at r V_p, r =
+    ``EXPECTED_RATIO`` e_p ± ``EXPECTED_RATIO_SD`` (as ``hidden_rebound``)."""
+    r = EXPECTED_RATIO * parent.restitution
+    xr = r * parent.x
+    e_r = _at("e", xr)
+    de_dlnx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (2.0 * math.log(1.05))
+    e_sd = math.hypot(abs(de_dlnx) * EXPECTED_RATIO_SD, parent.restitution_sd, LOT_RESTITUTION_SD)
+    return parent.impulse * r * (1.0 + e_r) / (1.0 + parent.restitution), e_r, e_sd
+
+
+def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
+                             fruit: list[PulseSummary]) -> dict | None:
+    """Is ``candidate``, one pulse judged no rebound, the rebounds of two earlier contacts that landed together?
+
+    On a chain-fed line one fruit's second bounce and the next fruit's first often land within a fraction of a
+    millisecond: one pulse that a single force law fits, taken for a new fruit that never was, graded.  What it
+    carries is the two rebounds': the impulse I_p r (1 + e_r)/(1 + e_p) of each (the same fruit at r V_p, r =
+    ``EXPECTED_RATIO`` e_p ± ``EXPECTED_RATIO_SD``) added, and a rebound's restitution (a slower impact: livelier
+    than the lane's fruit).  Of the pairs of ``due`` contacts (``rebounds_due``), the nearest in impulse and
+    restitution (in sd) is taken when it lies within ``PAIR_DISTANCE_MAX`` and a new fruit of the lane (the
+    medians and robust spreads of its measured ``fruit``, at least ``LANE_FRUIT_MIN``; spreads at least
+    ``LOT_IMPULSE_SD`` and ``LOT_RESTITUTION_SD``) lies ``PAIR_MARGIN`` times farther.  Returns the evidence
+    (``kind`` "two rebounds", ``parents``, both distances) or None."""
+    if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or len(due) < 2:
+        return None
+    log_impulse = np.log([f.impulse for f in fruit])
+    impulse_lane = float(np.exp(np.median(log_impulse)))
+    impulse_sd = math.hypot(max(_robust_sd(log_impulse), LOT_IMPULSE_SD), candidate.impulse_sd)
+    e_lane = float(np.median([f.restitution for f in fruit]))
+    e_lane_sd = math.hypot(max(_robust_sd([f.restitution for f in fruit]), LOT_RESTITUTION_SD),
+                           candidate.restitution_sd)
+    new_fruit = math.hypot(math.log(candidate.impulse / impulse_lane) / impulse_sd,
+                           (candidate.restitution - e_lane) / e_lane_sd)
+    pulses = [(parent.sequence, _rebound_pulse(parent)) for parent in due]
+    best = None
+    for i, (first, (i1, e1, s1)) in enumerate(pulses):
+        for second, (i2, e2, s2) in pulses[i + 1:]:
+            both = i1 + i2
+            both_sd = math.hypot(EXPECTED_RATIO_SD * math.hypot(i1, i2) / both, candidate.impulse_sd)
+            # the summed pulse's restitution leans to the larger pulse's: weighted by impulse (the weighting itself
+            # uncertain by a quarter of their difference)
+            e_pair = (i1 * e1 + i2 * e2) / both
+            e_sd = math.hypot((i1 * s1 + i2 * s2) / both, abs(e1 - e2) / 4.0, candidate.restitution_sd)
+            distance = math.hypot(math.log(candidate.impulse / both) / both_sd, (candidate.restitution - e_pair) / e_sd)
+            if best is None or distance < best[0]:
+                best = (distance, [first, second], both, e_pair)
+    distance, parents, both, e_pair = best
+    if not (distance <= PAIR_DISTANCE_MAX and new_fruit >= PAIR_MARGIN * distance):
+        return None
+    return {"kind": "two rebounds", "parents": parents, "impulse": candidate.impulse, "impulse_predicted": both,
+            "restitution": candidate.restitution, "restitution_predicted": e_pair, "pair_distance": round(distance, 3),
+            "lane_fruit_impulse": impulse_lane, "lane_fruit_restitution": e_lane, "lane_fruit": len(fruit),
+            "new_fruit_distance": round(new_fruit, 3),
+            "reason": f"one pulse carrying the impulse and restitution of the rebounds of #{parents[0]} and "
+                      f"#{parents[1]} together ({candidate.impulse / both:.2f} of their impulse, e "
+                      f"{candidate.restitution:.2f} against {e_pair:.2f}: {distance:.1f} sd), where a new fruit of "
+                      f"the lane lies {new_fruit:.1f} sd away (e {e_lane:.2f})"}
 
 
 def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, fruit: list[PulseSummary],
