@@ -44,7 +44,7 @@ from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
                                          hidden_rebound, judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         rebounds_landed_together,
+                                         rebounds_landed_together, claimed_parent,
                                          rebounds_due,
                                          refine, shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
@@ -239,9 +239,13 @@ class LineAnalyzer:
                     if reports[-1]["rebound"] and not spread <= PIECE_PRECISION:
                         # a rebound is graded with its fruit, so the piece stays with its parent, but its amplitude
                         # traded off against the other pulse's: neither its peak nor its fit is a measurement
-                        for key in (*FIRMNESS_KEYS, *(k for key in FIT_KEYS for k in (key, f"{key}_stderr"))):
+                        for key in (*FIRMNESS_KEYS, *(f"raw_{key}" for key in FIRMNESS_KEYS),
+                                    *(k for key in FIT_KEYS for k in (key, f"{key}_stderr"))):
                             if key in reports[-1]:
                                 reports[-1][key] = math.nan
+                        if "fit_converged" in reports[-1]:
+                            reports[-1].update(fit_converged=False, fit_message="a joint fit of two pulses, whose "
+                                               "amplitudes trade off: not a fit of this rebound alone")
                         reports[-1].update(status="overlap", message=(
                             f"a rebound landing on another fruit's contact, told apart by a joint fit of the pulses; "
                             f"its peak force is determined to ±{spread:.1%} only (at most ±{PIECE_PRECISION:.0%})"))
@@ -360,18 +364,20 @@ class LineAnalyzer:
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
-        together = pair = None
+        together = pair = pair_parents = None
         if not rebound and status == "ok" and summary is not None and due:
             lane_fruit = self._fruit.get(impact.lane, [])
             together = landed_with_rebound(summary, list(due), lane_fruit)
-            pair = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
+            found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
+            pair, pair_parents = found if found is not None else (None, None)
         if together is not None:  # one fruit fitted through two pulses would be a wrong grade: no firmness
-            status, chosen, summary = "overlap", None, None
-            message = f"a fruit and a rebound landing together: {together['reason']}; no firmness"
+            status, chosen, summary, hidden_fruit = "overlap", None, None, False
+            held = "a rebound" if len(together["parents"]) == 1 else "two rebounds"
+            message = f"a fruit and {held} landing together: {together['reason']}; no firmness"
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
         elif pair is not None:  # no fruit at all: two rebounds, each of its own parent
-            status, chosen, summary, rebound = "overlap", None, None, True
+            status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
             for key in FIRMNESS_KEYS:
                 report[key] = math.nan
@@ -380,7 +386,7 @@ class LineAnalyzer:
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
         elif rebound and chosen is not None:
-            index = next(i for i, s in enumerate(history) if s.sequence == chosen.parent)
+            index = claimed_parent(summary, history, chosen.parent)
             parent = history[index]
             history[index] = parent.taken()
             # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
@@ -408,10 +414,11 @@ class LineAnalyzer:
         if not rebound and status != "overlap":
             self._last_fruit[impact.lane] = report["start_time"]
         if pair is not None:  # both rebounds are seen, and each may bounce again from here
-            for index, parent in enumerate(list(history)):
-                if parent.sequence in pair["parents"]:
+            for parent in pair_parents:
+                index = next((i for i, s in enumerate(history) if s is parent), None)
+                if index is not None:
                     history[index] = parent.taken()
-                    history.append(hidden_rebound(parent, sequence, report["start_time"]))
+                history.append(hidden_rebound(parent, sequence, report["start_time"]))
         elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))

@@ -58,7 +58,7 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
-           "landed_with_rebound", "rebounds_landed_together",
+           "landed_with_rebound", "rebounds_landed_together", "claimed_parent",
            "likeliest_hidden",
            "judge_unmeasured",
            "rebounds_due", "refine", "shape_table"]
@@ -309,6 +309,17 @@ def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: f
                    best["speed_ratio"] if rebound else None, best)
 
 
+def claimed_parent(candidate: PulseSummary, earlier: list[PulseSummary], sequence: int) -> int:
+    """The index in ``earlier`` of the contact whose rebound ``candidate`` was judged to be (``judge`` names it by
+    its ``sequence``): of the entries with that sequence not yet rebounded, the one whose hypothesis scores best.
+    Two rebounds hidden in one overlap (``hidden_rebound``) share the overlap's sequence, and the one the
+    candidate matched must be the one marked taken."""
+    named = [i for i, p in enumerate(earlier) if p.sequence == sequence and not p.rebound_taken]
+    if len(named) <= 1:
+        return named[0] if named else next(i for i, p in enumerate(earlier) if p.sequence == sequence)
+    return min(named, key=lambda i: _hypothesis(candidate, earlier[i])["score"])
+
+
 def rebounds_due(onset: float, end: float, earlier: list[PulseSummary], *, max_flight: float) -> list[PulseSummary]:
     """The earlier contacts whose rebound, not yet seen, is due to land during [onset, end] [s], latest first.
 
@@ -442,24 +453,29 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
     if not fruit_distance > z:
         return None
     best = None
-    for parent in due:
-        r = EXPECTED_RATIO * parent.restitution
-        rebound_impulse = parent.impulse * r * (1.0 + _at("e", r * parent.x)) / (1.0 + parent.restitution)
+    impulses = [(parent.sequence, _rebound_pulse(parent)[0]) for parent in due]
+    # a fruit with one due rebound, or with two (a chain line's fruit, the last one's rebound and the one before's
+    # second bounce can land within a millisecond)
+    groups = [[one] for one in impulses] + [[a, b] for k, a in enumerate(impulses) for b in impulses[k + 1:]]
+    for group in groups:
+        rebound_impulse = sum(impulse for _, impulse in group)
         both = impulse_lane + rebound_impulse
-        both_sd = math.hypot(impulse_lane * impulse_sd, rebound_impulse * EXPECTED_RATIO_SD) / both
+        both_sd = math.hypot(impulse_lane * impulse_sd,
+                             EXPECTED_RATIO_SD * math.sqrt(sum(impulse ** 2 for _, impulse in group))) / both
         distance = abs(math.log(candidate.impulse / both)) / math.hypot(both_sd, candidate.impulse_sd)
         if best is None or distance < best["together_distance"]:
-            best = {"landed_with_rebound_of": parent.sequence, "impulse": candidate.impulse,
-                    "lane_fruit_impulse": impulse_lane, "rebound_impulse_predicted": rebound_impulse,
-                    "lane_fruit": len(fruit), "fruit_distance": round(fruit_distance, 3),
-                    "together_distance": distance}
+            best = {"landed_with_rebound_of": group[0][0], "parents": [sequence for sequence, _ in group],
+                    "impulse": candidate.impulse, "lane_fruit_impulse": impulse_lane,
+                    "rebound_impulse_predicted": rebound_impulse, "lane_fruit": len(fruit),
+                    "fruit_distance": round(fruit_distance, 3), "together_distance": distance}
     if not (best["together_distance"] < fruit_distance and best["together_distance"] <= z):
         return None
     best["together_distance"] = round(best["together_distance"], 3)
+    held = " and ".join(f"#{sequence}" for sequence in best["parents"])
     best["reason"] = (f"one pulse carrying {candidate.impulse / impulse_lane:.2f} times the impulse of the lane's "
                       f"{len(fruit)} measured fruit ({fruit_distance:.1f} sd above them) where the rebound of "
-                      f"#{best['landed_with_rebound_of']} was due; a fruit and that rebound together carry "
-                      f"{(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
+                      f"{held} was due; a fruit and {'that rebound' if len(best['parents']) == 1 else 'those rebounds'} "
+                      f"together carry {(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
                       f"({best['together_distance']:.1f} sd)")
     return best
 
@@ -488,7 +504,7 @@ def _rebound_pulse(parent: PulseSummary) -> tuple[float, float, float]:
 
 
 def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
-                             fruit: list[PulseSummary]) -> dict | None:
+                             fruit: list[PulseSummary]) -> tuple[dict, list[PulseSummary]] | None:
     """Is ``candidate``, one pulse judged no rebound, the rebounds of two earlier contacts that landed together?
 
     On a chain-fed line one fruit's second bounce and the next fruit's first often land within a fraction of a
@@ -498,8 +514,8 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
     than the lane's fruit).  Of the pairs of ``due`` contacts (``rebounds_due``), the nearest in impulse and
     restitution (in sd) is taken when it lies within ``PAIR_DISTANCE_MAX`` and a new fruit of the lane (the
     medians and robust spreads of its measured ``fruit``, at least ``LANE_FRUIT_MIN``; spreads at least
-    ``LOT_IMPULSE_SD`` and ``LOT_RESTITUTION_SD``) lies ``PAIR_MARGIN`` times farther.  Returns the evidence
-    (``kind`` "two rebounds", ``parents``, both distances) or None."""
+    ``LOT_IMPULSE_SD`` and ``LOT_RESTITUTION_SD``) lies ``PAIR_MARGIN`` times farther.  Returns (the evidence:
+    ``kind`` "two rebounds", ``parents`` (their sequences), both distances; the two parents themselves) or None."""
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or len(due) < 2:
         return None
     log_impulse = np.log([f.impulse for f in fruit])
@@ -510,7 +526,7 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
                            candidate.restitution_sd)
     new_fruit = math.hypot(math.log(candidate.impulse / impulse_lane) / impulse_sd,
                            (candidate.restitution - e_lane) / e_lane_sd)
-    pulses = [(parent.sequence, _rebound_pulse(parent)) for parent in due]
+    pulses = [(parent, _rebound_pulse(parent)) for parent in due]
     best = None
     for i, (first, (i1, e1, s1)) in enumerate(pulses):
         for second, (i2, e2, s2) in pulses[i + 1:]:
@@ -523,9 +539,10 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
             distance = math.hypot(math.log(candidate.impulse / both) / both_sd, (candidate.restitution - e_pair) / e_sd)
             if best is None or distance < best[0]:
                 best = (distance, [first, second], both, e_pair)
-    distance, parents, both, e_pair = best
+    distance, pair, both, e_pair = best
     if not (distance <= PAIR_DISTANCE_MAX and new_fruit >= PAIR_MARGIN * distance):
         return None
+    parents = [parent.sequence for parent in pair]
     return {"kind": "two rebounds", "parents": parents, "impulse": candidate.impulse, "impulse_predicted": both,
             "restitution": candidate.restitution, "restitution_predicted": e_pair, "pair_distance": round(distance, 3),
             "lane_fruit_impulse": impulse_lane, "lane_fruit_restitution": e_lane, "lane_fruit": len(fruit),
@@ -533,7 +550,7 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
             "reason": f"one pulse carrying the impulse and restitution of the rebounds of #{parents[0]} and "
                       f"#{parents[1]} together ({candidate.impulse / both:.2f} of their impulse, e "
                       f"{candidate.restitution:.2f} against {e_pair:.2f}: {distance:.1f} sd), where a new fruit of "
-                      f"the lane lies {new_fruit:.1f} sd away (e {e_lane:.2f})"}
+                      f"the lane lies {new_fruit:.1f} sd away (e {e_lane:.2f})"}, pair
 
 
 def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, fruit: list[PulseSummary],
