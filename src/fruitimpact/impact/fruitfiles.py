@@ -33,10 +33,7 @@ def fitted_stress_warnings(inputs: InputColumns, resolved, where, name: str, mes
     for label in files:
         fitted = library.fitted_criterion(fruits[label]) if label in fruits else None
         if fitted is not None and fitted != name:
-            warnings.add(using & (resolved.fruit_of == label),
-                         f"failure_stress of the fruit file {label} was fitted under the {fitted} criterion and is "
-                         f"used here under {name}: the onset moves (give --criterion {fitted}, or a failure stress "
-                         f"fitted under {name})")
+            warnings.add(using & (resolved.fruit_of == label), library.fitted_criterion_message(label, fitted, name))
 
 
 __all__ = ["fitted_stress_warnings", "plausibility"]

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from fruitimpact.library import catalogue as library
-from fruitimpact.impact.quantities import INPUTS
+from fruitimpact.impact.quantities import FRUIT_FIELD_INPUTS, INPUTS
 
 #: The library's names of fruit properties that differ from the inputs' names.
-_FRUIT_KEYS = {"bruise_threshold_energy": "bruise_energy"}
+_FRUIT_KEYS = {field: name for field, name in FRUIT_FIELD_INPUTS.items() if field != name}
 _LIBRARY_KEYS = {value: key for key, value in _FRUIT_KEYS.items()}
 #: Surface models as codes.
 HALF_SPACE, LAYER = 0, 1
@@ -272,9 +272,7 @@ def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: 
     drawn = {name for name, _ in lot.distributions}
     if fitted is not None and criterion in ("pressure", "shear") and criterion != fitted and "failure_stress" in drawn:
         # the lot's rows carry the drawn stress as given: the evaluation's warning of it is said here, once
-        described += (f"warning: failure_stress of the fruit file {fruit} was fitted under the {fitted} criterion "
-                      f"and is used here under {criterion}: the onset moves (give --criterion {fitted}, or a failure "
-                      f"stress fitted under {criterion})",)
+        described += (f"warning: {library.fitted_criterion_message(fruit, fitted, criterion)}",)
     return lot.distributions, lot.diameter_density, described
 
 

@@ -374,6 +374,13 @@ def option_of(name: str) -> str:
     return quantity.option if quantity is not None and quantity.option else "--" + name.replace("_", "-")
 
 
-__all__ = ["DAMAGE_NAMES", "ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
+#: The fruit fields (columns of the fruit library and of a fruit file) a simulation takes as inputs, and the input
+#: each one is: a fruit's value passes that input's checks, as the option would, and fills that input's rows.
+FRUIT_FIELD_INPUTS = {"mass": "mass", "diameter": "diameter", "modulus": "modulus", "poisson": "poisson",
+                      "failure_stress": "failure_stress", "restitution": "restitution", "alpha": "alpha",
+                      "bruise_susceptibility": "bruise_susceptibility", "bruise_threshold_energy": "bruise_energy",
+                      "bruise_width_ratio": "bruise_width_ratio"}
+
+__all__ = ["DAMAGE_NAMES", "FRUIT_FIELD_INPUTS", "ALLOWED_BOUNDS", "ALTERNATIVES", "CHARACTERISTICS", "CHARACTERISTIC_NAMES", "DEFAULT_SUMMARY",
            "GROUP_DEFAULTS", "INPUTS", "NON_NEGATIVE", "NUMERIC_DEFAULTS", "PLAUSIBLE_BOUNDS", "inside", "NUMERIC_INPUTS", "OUTPUTS", "POSITIVE", "POSITIVE_OR_INFINITE", "Quantity",
            "Range", "TEXT_INPUTS", "option_of"]

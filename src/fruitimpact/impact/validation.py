@@ -19,7 +19,7 @@ import numbers
 
 import numpy as np
 
-from fruitimpact.impact.quantities import INPUTS, Quantity, Range, option_of
+from fruitimpact.impact.quantities import FRUIT_FIELD_INPUTS, INPUTS, Quantity, Range, option_of
 from fruitimpact.impact.units import UNITS, parse_quantity
 
 
@@ -348,21 +348,15 @@ COMMAND_ARGUMENTS = {"bounces": "--bounces", "max_impacts": "--max-impacts", "al
                      "tests": "TESTS", "fitted_name": "--name"}
 
 
-#: The fruit fields a simulation takes as inputs, and the input (``impact.quantities.INPUTS``) each one is: a fruit
-#: file's value passes that input's checks, as the option would.
-FILE_INPUTS = {"mass": "mass", "diameter": "diameter", "modulus": "modulus", "poisson": "poisson",
-               "failure_stress": "failure_stress", "restitution": "restitution", "alpha": "alpha",
-               "bruise_susceptibility": "bruise_susceptibility", "bruise_threshold_energy": "bruise_energy",
-               "bruise_width_ratio": "bruise_width_ratio"}
 
 
 def check_fruit_file(entry, shown: str) -> None:
     """A fruit file's values (and their ranges' ends, which a lot draws from) inside the allowed range of the input
-    each one is (``FILE_INPUTS``): the check ``--mass``, ``--modulus``, … get, refused the same way (naming the
+    each one is (``quantities.FRUIT_FIELD_INPUTS``): the check ``--mass``, ``--modulus``, … get, refused the same way (naming the
     file, the column and the value)."""
     from fruitimpact.library.catalogue import LibraryError
 
-    for field, name in FILE_INPUTS.items():
+    for field, name in FRUIT_FIELD_INPUTS.items():
         value = getattr(entry, field)
         if value is None:
             continue
@@ -375,7 +369,7 @@ def check_fruit_file(entry, shown: str) -> None:
 
 def fruit_file_warnings(path) -> list[tuple[str, str]]:
     """The plausibility warnings of a fruit file's values, as the options get them: (input name, warning) for each
-    value of ``FILE_INPUTS`` outside its input's plausible range for fruit (``implausible_message``, naming the
+    value of ``quantities.FRUIT_FIELD_INPUTS`` outside its input's plausible range for fruit (``implausible_message``, naming the
     file).  The file is loaded (:func:`load_fruit_file`; ``LibraryError`` if it cannot be)."""
     import os
 
@@ -383,7 +377,7 @@ def fruit_file_warnings(path) -> list[tuple[str, str]]:
 
     entry = load_fruit_file(path)
     out = []
-    for field, name in FILE_INPUTS.items():
+    for field, name in FRUIT_FIELD_INPUTS.items():
         value = getattr(entry, field)
         quantity = INPUTS[name]
         if value is None or quantity.plausible is None or quantity.plausible.contains(float(value.value)):
@@ -403,7 +397,7 @@ def _register_fruit_file_checks() -> None:
 _register_fruit_file_checks()
 
 
-__all__ = ["FILE_INPUTS", "InputError", "check_fruit_file", "fruit_file_warnings", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag", "choice_message",
+__all__ = ["InputError", "check_fruit_file", "fruit_file_warnings", "MessageBook", "WarningBook", "check_choice", "check_conflicts", "check_flag", "choice_message",
            "check_input_name", "spec_text", "check_value", "conflict_message",
            "implausible_message", "nan_message", "range_message", "read_count", "read_value",
            "unreadable_message", "COMMAND_ARGUMENTS", "usage_message", "is_boolean"]

@@ -11,11 +11,13 @@ docs/library.md has the tables, their sources and what the flags mean.
 
 from fruitimpact.library.catalogue import (ENERGY_BASED, ENERGY_BASES, FITTED_BY, FRUIT_COLUMNS,
                                            FRUIT_UNITS, SURFACE_MODELS, SURFACE_UNITS, Fruit, FruitRegistry,
-                                           LibraryError, Surface, Value, fitted_criterion, fruit, fruit_file_text,
+                                           LibraryError, Surface, Value, fitted_criterion,
+                                           fitted_criterion_message, fruit, fruit_file_text,
                                            fruit_rows, fruits, is_fruit_file, load_fruit_file,
                                            read_fruit_file, surface, surface_rows, surfaces)
 
 __all__ = ["ENERGY_BASED", "ENERGY_BASES", "FITTED_BY", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS",
-           "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion", "fruit",
+           "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion",
+           "fitted_criterion_message", "fruit",
            "fruit_file_text", "fruit_rows", "fruits", "is_fruit_file", "load_fruit_file",
            "read_fruit_file", "surface", "surface_rows", "surfaces"]

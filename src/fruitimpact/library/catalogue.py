@@ -40,7 +40,8 @@ from types import MappingProxyType
 from fruitimpact.library.textfiles import table_lines
 
 __all__ = ["ENERGY_BASED", "FILE_CHECKS", "ENERGY_BASES", "FITTED_BY", "FRUIT_COLUMNS", "FRUIT_UNITS", "SURFACE_MODELS",
-           "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion", "fruit",
+           "SURFACE_UNITS", "Fruit", "FruitRegistry", "LibraryError", "Surface", "Value", "fitted_criterion",
+           "fitted_criterion_message", "fruit",
            "fruit_file_text", "fruit_rows", "fruits", "is_fruit_file", "load_fruit_file",
            "read_fruit_file", "surface", "surface_rows", "surfaces"]
 
@@ -485,6 +486,13 @@ def fitted_criterion(entry: Fruit) -> str | None:
     if stress is None or FITTED_BY not in stress.source:
         return None
     return entry.criterion
+
+
+def fitted_criterion_message(fruit: str, fitted: str, used: str) -> str:
+    """The warning for the failure stress of fruit file ``fruit``, fitted under criterion ``fitted`` and used under
+    ``used`` (the stress at onset differs between criteria)."""
+    return (f"failure_stress of the fruit file {fruit} was fitted under the {fitted} criterion and is used here under "
+            f"{used}: the onset moves (give --criterion {fitted}, or a failure stress fitted under {used})")
 
 
 def _cell(value) -> str:
