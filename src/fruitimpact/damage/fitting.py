@@ -299,9 +299,10 @@ def _penalised(loglik, low, high):
     return negative
 
 
-def _half_width(negative, theta_hat, value_hat, index):
-    """A first guess of the 95 % half-width of coordinate ``index``: 1.96 standard errors from the curvature of
-    ``negative`` at the estimate (central differences), 0.2 where it is not positive definite."""
+def _half_widths(negative, theta_hat) -> np.ndarray:
+    """First guesses of the 95 % half-widths of every coordinate: 1.96 standard errors from the curvature of
+    ``negative`` at the estimate (central differences, one Hessian for all), 0.2 where it is not positive
+    definite."""
     n, h = theta_hat.size, 1e-3
     hessian = np.empty((n, n))
     for i in range(n):
@@ -314,16 +315,19 @@ def _half_width(negative, theta_hat, value_hat, index):
                 theta[j] += b * h
                 values.append(negative(theta))
             hessian[i, j] = hessian[j, i] = (values[0] - values[1] - values[2] + values[3]) / (4.0 * h * h)
+    widths = np.full(n, 0.2)
     if not np.all(np.isfinite(hessian)):
-        return 0.2  # a step left the likelihood's finite region: no curvature (and no LAPACK on NaN)
+        return widths  # a step left the likelihood's finite region: no curvature (and no LAPACK on NaN)
     try:
-        variance = np.linalg.inv(hessian)[index, index]
+        variance = np.diag(np.linalg.inv(hessian))
     except np.linalg.LinAlgError:
-        return 0.2
-    return 1.96 * math.sqrt(variance) if variance > 0.0 and math.isfinite(variance) else 0.2
+        return widths
+    good = np.isfinite(variance) & (variance > 0.0)
+    widths[good] = 1.96 * np.sqrt(variance[good])
+    return widths
 
 
-def _profile(negative, theta_hat, index, value_hat, low, high):
+def _profile(negative, theta_hat, index, value_hat, low, high, first: float | None = None):
     """The (low, high) ends of the 95 % profile interval of coordinate ``index`` (None where not reached inside the
     box): where the signed root r(ψ) = √(2 (ℓ̂ − ℓ_p(ψ))) reaches 1.96.  r is nearly linear in ψ, so a secant
     on it from a first step of 1.96 standard errors converges in a few profile maximisations, each started from the
@@ -344,7 +348,8 @@ def _profile(negative, theta_hat, index, value_hat, low, high):
         rest, value = _simplex(restricted, start, restricted(start), np.full(len(others), 0.03), 1e-5, 4000)
         return math.sqrt(max(0.0, 2.0 * (value - value_hat))), rest
 
-    first = _half_width(negative, theta_hat, value_hat, index)
+    if first is None:  # the first step: 1.96 standard errors (``_half_widths``, computed once by callers of several)
+        first = float(_half_widths(negative, theta_hat)[index])
     ends = []
     for direction, limit in ((-1.0, low[index]), (1.0, high[index])):
         psi_hat = theta_hat[index]
@@ -431,8 +436,9 @@ def fit_volumes(energy, volume) -> BruiseFit:
     theta, value = _best_of(negative, [np.clip(start, low, high) for start in starts], np.full(4, 0.3))
     shift = np.array([ln_v0 - ln_w0, ln_w0, 0.0, 0.0])  # scaled θ → θ in SI
     intervals = {}
+    widths = _half_widths(negative, theta)  # one Hessian for both profiles
     for index, name in ((0, "bruise_susceptibility"), (1, "bruise_energy")):
-        ends = _profile(negative, theta, index, value, low, high)
+        ends = _profile(negative, theta, index, value, low, high, float(widths[index]))
         intervals[name] = tuple(None if end is None else math.exp(end + shift[index]) for end in ends)
     estimates = {"bruise_susceptibility": math.exp(theta[0] + shift[0]), "bruise_energy": math.exp(theta[1] + shift[1]),
                  "threshold_spread": math.exp(theta[2]), "volume_scatter": math.exp(theta[3])}
