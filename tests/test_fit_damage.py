@@ -957,6 +957,10 @@ def test_a_quoted_field_over_several_lines_is_one_field(tmp_path):
     path = tmp_path / "t.csv"
     path.write_text('a,b\n# a comment\n1,"x\n\n# not a comment\ny"\n\n2,"q""r"\n')
     assert table_lines(path) == [(1, "a,b\n"), (3, '1,"x\n\n# not a comment\ny"\n'), (8, '2,"q""r"\n')]
+    # a stray quote would take every line after it into one field: refused, naming the line it opened on
+    path.write_text('a,b\n1,"x\n2,y\n3,z\n')
+    with pytest.raises(ValueError, match=r"line 2: a quoted field opened there is never closed"):
+        table_lines(path)
     apple = catalogue.fruit("apple")
     text = catalogue.fruit_file_text(apple)
     header, row = text.rstrip("\n").split("\n")[-2:]

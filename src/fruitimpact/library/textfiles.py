@@ -26,17 +26,21 @@ def table_lines(path, what: str = "", name: str | None = None) -> list[tuple[int
         raise ValueError(f"{what}cannot read {shown}: it is a folder, not a CSV file")
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:  # an Excel export starts with a BOM
-            return _records(enumerate(handle, start=1))
+            records = _records(enumerate(handle, start=1))
     except OSError as exc:
         raise ValueError(f"{what}cannot read {shown}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         raise ValueError(f"{what}cannot read {shown}: not a UTF-8 text file") from None
+    if records and records[-1][1].count('"') % 2:
+        # a stray quote would take every line after it into one field: rows lost without a word
+        raise ValueError(f"{what}{shown}, line {records[-1][0]}: a quoted field opened there is never closed")
+    return records
 
 
 def _records(numbered) -> list[tuple[int, str]]:
     """Join the lines of a record whose quoted field runs over line breaks (an odd number of ``"`` so far: CSV
     doubles a quote inside a quoted field, so the parity says whether a quote is open); an unclosed quote at
-    the end is left for the CSV reader to refuse."""
+    the end stays one record, with its odd count (``table_lines`` refuses it)."""
     records, pending, first = [], None, 0
     for number, line in numbered:
         if pending is not None:
