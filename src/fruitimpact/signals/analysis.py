@@ -42,11 +42,10 @@ from fruitimpact.impact.validation import InputError
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, expected_rebound, from_indices,
-                                         hidden_rebound, judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         rebounds_landed_together, claimed_parent,
-                                         rebounds_due,
-                                         refine, shape_table)
+from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
+                                         from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
+                                         likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
+                                         shape_table)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -239,10 +238,7 @@ class LineAnalyzer:
                     if reports[-1]["rebound"] and not spread <= PIECE_PRECISION:
                         # a rebound is graded with its fruit, so the piece stays with its parent, but its amplitude
                         # traded off against the other pulse's: neither its peak nor its fit is a measurement
-                        for key in (*FIRMNESS_KEYS, *(f"raw_{key}" for key in FIRMNESS_KEYS),
-                                    *(k for key in FIT_KEYS for k in (key, f"{key}_stderr"))):
-                            if key in reports[-1]:
-                                reports[-1][key] = math.nan
+                        _without_firmness(reports[-1], fit=True)
                         if "fit_converged" in reports[-1]:
                             reports[-1].update(fit_converged=False, fit_message="a joint fit of two pulses, whose "
                                                "amplitudes trade off: not a fit of this rebound alone")
@@ -251,8 +247,7 @@ class LineAnalyzer:
                             f"its peak force is determined to ±{spread:.1%} only (at most ±{PIECE_PRECISION:.0%})"))
             return reports
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
-            for key in FIRMNESS_KEYS:
-                report[key] = math.nan
+            _without_firmness(report)
             inside = own.window[impact.start_index - own.window_start:impact.end_index + 1 - own.window_start]
             report.update(start_time=impact.start_index / analysis.rate,
                           time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
@@ -374,13 +369,11 @@ class LineAnalyzer:
             status, chosen, summary, hidden_fruit = "overlap", None, None, False
             held = "a rebound" if len(together["parents"]) == 1 else "two rebounds"
             message = f"a fruit and {held} landing together: {together['reason']}; no firmness"
-            for key in FIRMNESS_KEYS:
-                report[key] = math.nan
+            _without_firmness(report)
         elif pair is not None:  # no fruit at all: two rebounds, each of its own parent
             status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
-            for key in FIRMNESS_KEYS:
-                report[key] = math.nan
+            _without_firmness(report)
         speed = analysis.velocity
         if rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
@@ -533,6 +526,17 @@ def _imprecise(parts, rebounds) -> float | None:
     worst = max((_relative_peak_error(fit) for (_, fit), rebound in zip(parts, rebounds) if not rebound),
                 default=0.0)
     return worst if not worst <= PIECE_PRECISION else None
+
+
+def _without_firmness(report: dict, fit: bool = False) -> None:
+    """Blank a report's firmness (an overlap has none): the indices' and their measured ``raw_`` values, and with
+    ``fit`` the fitted values and their standard errors too (a piece whose fit is no measurement)."""
+    keys = (*FIRMNESS_KEYS, *(f"raw_{key}" for key in FIRMNESS_KEYS))
+    if fit:
+        keys += tuple(k for key in FIT_KEYS for k in (key, f"{key}_stderr"))
+    for key in keys:
+        if key in report or key in FIRMNESS_KEYS:
+            report[key] = math.nan
 
 
 def _relative_peak_error(fit: dict) -> float:

@@ -57,11 +57,9 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-__all__ = ["AMBIGUOUS", "PulseSummary", "TOLERANCES", "Verdict", "from_indices", "judge", "expected_rebound", "hidden_rebound",
-           "landed_with_rebound", "rebounds_landed_together", "claimed_parent",
-           "likeliest_hidden",
-           "judge_unmeasured",
-           "rebounds_due", "refine", "shape_table"]
+__all__ = ["AMBIGUOUS", "LaneFruit", "PulseSummary", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound",
+           "from_indices", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
+           "likeliest_hidden", "rebounds_due", "rebounds_landed_together", "refine", "shape_table"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
@@ -398,9 +396,8 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
     guess = expected_rebound(parent)
     r = EXPECTED_RATIO * parent.restitution
     xr = guess["x"]
-    e_r = _at("e", xr)
+    impulse, e_r, _ = _rebound_pulse(parent)
     de_dx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (xr * (1.05 - 1.0 / 1.05)) if xr > 0 else 0.0
-    impulse = parent.impulse * r * (1.0 + e_r) / (1.0 + parent.restitution)
     tc = parent.time_to_peak * r ** -0.2 * _at("tc", xr) / _at("tc", parent.x)
     return PulseSummary(sequence=sequence, onset=onset, separation=onset + math.exp(guess["log_duration"]),
                         peak_force=math.exp(guess["log_peak"]), time_to_peak=tc, impulse=impulse, x=xr,
@@ -422,6 +419,25 @@ LANE_FRUIT_MIN = 5
 def _robust_sd(values) -> float:
     values = np.asarray(values, dtype=float)
     return float(1.4826 * np.median(np.abs(values - np.median(values))))
+
+
+@dataclass(frozen=True)
+class LaneFruit:
+    """What a lane's measured new fruit say of the next one: the median ``impulse`` [N s] and the robust sd of its
+    logarithm, the median ``restitution`` and its robust sd (each caller floors the spreads as its test needs)."""
+
+    impulse: float
+    impulse_sd: float
+    restitution: float
+    restitution_sd: float
+
+
+def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
+    """The ``LaneFruit`` of the measured ``fruit`` of a lane (``analysis`` keeps the last ``LANE_FRUIT_KEPT``)."""
+    log_impulse = np.log([f.impulse for f in fruit])
+    restitution = [f.restitution for f in fruit]
+    return LaneFruit(float(np.exp(np.median(log_impulse))), _robust_sd(log_impulse), float(np.median(restitution)),
+                     _robust_sd(restitution))
 
 
 #: Least spread (sd of ln) of the impulse of a lane's fruit that ``landed_with_rebound`` assumes: fruit of one
@@ -446,9 +462,8 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or not due:
         return None
     z = TOLERANCES["z"]
-    log_impulse = np.log([f.impulse for f in fruit])
-    impulse_lane = float(np.exp(np.median(log_impulse)))
-    impulse_sd = max(_robust_sd(log_impulse), LOT_IMPULSE_SD)
+    lane = lane_fruit(fruit)
+    impulse_lane, impulse_sd = lane.impulse, max(lane.impulse_sd, LOT_IMPULSE_SD)
     fruit_distance = math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)
     if not fruit_distance > z:
         return None
@@ -472,9 +487,10 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
         return None
     best["together_distance"] = round(best["together_distance"], 3)
     held = " and ".join(f"#{sequence}" for sequence in best["parents"])
+    those = "that rebound" if len(best["parents"]) == 1 else "those rebounds"
     best["reason"] = (f"one pulse carrying {candidate.impulse / impulse_lane:.2f} times the impulse of the lane's "
                       f"{len(fruit)} measured fruit ({fruit_distance:.1f} sd above them) where the rebound of "
-                      f"{held} was due; a fruit and {'that rebound' if len(best['parents']) == 1 else 'those rebounds'} "
+                      f"{held} was due; a fruit and {those} "
                       f"together carry {(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
                       f"({best['together_distance']:.1f} sd)")
     return best
@@ -518,12 +534,10 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
     ``kind`` "two rebounds", ``parents`` (their sequences), both distances; the two parents themselves) or None."""
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or len(due) < 2:
         return None
-    log_impulse = np.log([f.impulse for f in fruit])
-    impulse_lane = float(np.exp(np.median(log_impulse)))
-    impulse_sd = math.hypot(max(_robust_sd(log_impulse), LOT_IMPULSE_SD), candidate.impulse_sd)
-    e_lane = float(np.median([f.restitution for f in fruit]))
-    e_lane_sd = math.hypot(max(_robust_sd([f.restitution for f in fruit]), LOT_RESTITUTION_SD),
-                           candidate.restitution_sd)
+    lane = lane_fruit(fruit)
+    impulse_lane, e_lane = lane.impulse, lane.restitution
+    impulse_sd = math.hypot(max(lane.impulse_sd, LOT_IMPULSE_SD), candidate.impulse_sd)
+    e_lane_sd = math.hypot(max(lane.restitution_sd, LOT_RESTITUTION_SD), candidate.restitution_sd)
     new_fruit = math.hypot(math.log(candidate.impulse / impulse_lane) / impulse_sd,
                            (candidate.restitution - e_lane) / e_lane_sd)
     pulses = [(parent, _rebound_pulse(parent)) for parent in due]
@@ -579,14 +593,14 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
         return NEW_FRUIT
     tol = TOLERANCES
     z = tol["z"]
-    e_lane = float(np.median([f.restitution for f in fruit]))
+    lane = lane_fruit(fruit)
+    e_lane = lane.restitution
     log_x = np.log([max(f.x, 1e-6) for f in fruit])
     x_lane, x_sd = float(np.exp(np.median(log_x))), max(_robust_sd(log_x), tol["shape"])
-    log_impulse = np.log([f.impulse for f in fruit])
-    impulse_lane, impulse_sd = float(np.exp(np.median(log_impulse))), max(_robust_sd(log_impulse), 0.05)
+    impulse_lane, impulse_sd = lane.impulse, max(lane.impulse_sd, 0.05)
     duration = float(np.median([f.separation - f.onset for f in fruit]))
     r = EXPECTED_RATIO * e_lane
-    r_sd = math.hypot(EXPECTED_RATIO_SD, _robust_sd([f.restitution for f in fruit]) / e_lane)
+    r_sd = math.hypot(EXPECTED_RATIO_SD, lane.restitution_sd / e_lane)
     xr = r * x_lane
     e_pred = _at("e", xr)
     de_dlnx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (2.0 * math.log(1.05))
@@ -618,7 +632,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     # the lane's fruit, within their spread).  Each test above is loose (a rebound's impulse, r (1 + e_r)/(1 + e)
     # ≈ 0.65 of a fruit's, lies within the lane's 3 sd of mass), so on the two tests both hypotheses share the
     # rebound must fit better than a new fruit does; otherwise the contact is a new fruit, said to be ambiguous
-    e_lane_sd = math.hypot(max(_robust_sd([f.restitution for f in fruit]), 1e-3), candidate.restitution_sd)
+    e_lane_sd = math.hypot(max(lane.restitution_sd, 1e-3), candidate.restitution_sd)
     new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
         (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2
     rebound2 = (deviations["restitution"] * z) ** 2 + (deviations["impulse"] * z) ** 2

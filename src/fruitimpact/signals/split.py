@@ -279,8 +279,8 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
     def row(shape_index, onset_index):
         return shape_index * n_o + onset_index
 
-    # the pairs of unit pulses, one per row of ``table``, in the order of the loops they replace: (row A, row B, duration A, duration B, x A, x B,
-    # expected k or −1, the pulse it is, B's onset sample); A starts with the contact
+    # the pairs of unit pulses, one per row of ``table``, in the order of the loops they replace: (row A, row B,
+    # duration A, duration B, x A, x B, expected k or −1, the pulse it is, B's onset sample); A starts with the contact
     blocks = []
     at_g, da_g, db_g = np.meshgrid(np.arange(n_g), generic, generic, indexing="ij")  # at, duration A, duration B
     at_g, da_g, db_g = at_g.ravel(), da_g.ravel(), db_g.ravel()
