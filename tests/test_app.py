@@ -189,9 +189,16 @@ def _cell(page, name: str) -> float:
     return float(page.text_content(f'#characteristics tr[data-name="{name}"] td.value').replace(",", ""))
 
 
-def test_the_explorer_in_a_real_browser(server, tmp_path):
+def screenshots(tmp_path) -> Path:
+    """Where a browser test keeps its screenshots: ``FRUITIMPACT_SCREENSHOTS`` if set (to look at them), else the
+    test's own folder."""
     shots = Path(os.environ.get("FRUITIMPACT_SCREENSHOTS", tmp_path))
     shots.mkdir(parents=True, exist_ok=True)
+    return shots
+
+
+def test_the_explorer_in_a_real_browser(server, tmp_path):
+    shots = screenshots(tmp_path)
     with browser_page(server) as page:
         page.goto(server)
         _wait(page, "window.fruitimpact.updates >= 1")

@@ -11,7 +11,6 @@ another host and on any console error.
 from __future__ import annotations
 
 import json
-import os
 import shlex
 import shutil
 import subprocess
@@ -21,7 +20,7 @@ import pytest
 
 from fruitimpact.impact.outputs import dump_json
 from fruitimpact.spheres.audit import sphere_audit
-from test_app import _post, _wait, browser_page, server  # noqa: F401 - server is a fixture
+from test_app import _post, _wait, browser_page, screenshots, server  # noqa: F401 - server is a fixture
 from test_app_signals import _upload
 
 pytest.importorskip("tornado")
@@ -200,9 +199,19 @@ def _number(text: str) -> float:
     return float(text.split()[0].replace(",", ""))
 
 
+def _audit_example_log(view) -> None:
+    """On the line page with the sphere as the source: the example log and its calibration chosen, the sphere's
+    fields filled, and the audit's answer awaited."""
+    view.select_option("select[name=sphere]", "is-1987")
+    view.fill("input[name=logger_rate]", "3kHz")
+    view.set_input_files("#sphere-calibration", str(EXAMPLES / CALIBRATION))
+    view.set_input_files("#sphere-log", str(EXAMPLES / LOG))
+    _wait(view, "window.fruitimpact.sphere !== null && window.fruitimpact.sphere.calibration_file !== null "
+                "&& window.fruitimpact.sphere.request.logger_rate === '3kHz'", 120)
+
+
 def test_a_sphere_log_in_place_of_the_table_in_a_real_browser(server, tmp_path, monkeypatch):
-    shots = Path(os.environ.get("FRUITIMPACT_SCREENSHOTS", tmp_path))
-    shots.mkdir(parents=True, exist_ok=True)
+    shots = screenshots(tmp_path)
     reference = _reference(EXAMPLES, monkeypatch, sphere_calibration=CALIBRATION, rows=line_page.PAGE_ROWS, seed=0,
                            fruit="apple", **SPHERE)
     with browser_page(server) as view:
@@ -212,12 +221,7 @@ def test_a_sphere_log_in_place_of_the_table_in_a_real_browser(server, tmp_path, 
         view.check("input[name=source][value=sphere]")
         assert view.is_visible("#sphere") and view.is_hidden("#points") and view.is_hidden("#what-if")
         assert view.is_hidden("#sphere-results")  # nothing to show before a log
-        view.select_option("select[name=sphere]", "is-1987")
-        view.fill("input[name=logger_rate]", "3kHz")
-        view.set_input_files("#sphere-calibration", str(EXAMPLES / CALIBRATION))
-        view.set_input_files("#sphere-log", str(EXAMPLES / LOG))
-        _wait(view, "window.fruitimpact.sphere !== null && window.fruitimpact.sphere.calibration_file !== null "
-                    "&& window.fruitimpact.sphere.request.logger_rate === '3kHz'", 120)
+        _audit_example_log(view)
         view.wait_for_selector("#sphere-points tbody tr.point")
 
         # the table: one row per transfer point, the worst one highlighted, each figure the library's (as shown:
@@ -298,20 +302,14 @@ def test_a_failed_audit_says_so_in_its_headline_in_a_real_browser(server, tmp_pa
     audit (``sphere_audit``'s status): the verdict at the top of the results says "failed" and why before the share
     bruised, which counts only the points computed, and its frame turns red; an audit that is ok shows no such
     line (the example log)."""
-    shots = Path(os.environ.get("FRUITIMPACT_SCREENSHOTS", tmp_path))
-    shots.mkdir(parents=True, exist_ok=True)
+    shots = screenshots(tmp_path)
     bad = tmp_path / "cannon-log.csv"
     bad.write_text((EXAMPLES / LOG).read_text() + "400.000,900,40,0.0005,cannon\n")
     with browser_page(server) as view:
         view.goto(server + "line")
         _wait(view, "window.fruitimpact.updates >= 1")
         view.check("input[name=source][value=sphere]")
-        view.select_option("select[name=sphere]", "is-1987")
-        view.fill("input[name=logger_rate]", "3kHz")
-        view.set_input_files("#sphere-calibration", str(EXAMPLES / CALIBRATION))
-        view.set_input_files("#sphere-log", str(EXAMPLES / LOG))
-        _wait(view, "window.fruitimpact.sphere !== null && window.fruitimpact.sphere.calibration_file !== null "
-                    "&& window.fruitimpact.sphere.request.logger_rate === '3kHz'", 120)
+        _audit_example_log(view)
         assert view.evaluate("window.fruitimpact.sphere.report.status") == "ok"
         assert view.locator("#sphere-verdict-status").count() == 0
         assert "not-ok" not in view.get_attribute("#sphere-verdict", "class")
