@@ -42,7 +42,7 @@ from fruitimpact.impact.validation import InputError
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
+from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
                                          from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
                                          likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
                                          shape_table)
@@ -361,7 +361,7 @@ class LineAnalyzer:
         rebound = chosen is not None and chosen.rebound
         together = pair = pair_parents = None
         if not rebound and status == "ok" and summary is not None and due:
-            lane_fruit = self._fruit.get(impact.lane, [])
+            lane_fruit = self._lane_fruit(impact.lane)
             together = landed_with_rebound(summary, list(due), lane_fruit)
             found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
             pair, pair_parents = found if found is not None else (None, None)
@@ -432,6 +432,15 @@ class LineAnalyzer:
         return report
 
 
+    def _lane_fruit(self, lane: int) -> list[PulseSummary]:
+        """The measured new fruit that stand for the next fruit of ``lane``: its own, or, until it has
+        ``LANE_FRUIT_MIN``, those of every lane (one lot on one line, landing at the one speed the analysis is
+        given: a lane just started, or one whose first fruit were hidden in overlaps, is judged by the line's)."""
+        own = self._fruit.get(lane, [])
+        if len(own) >= LANE_FRUIT_MIN or len(self._fruit) <= 1:
+            return own
+        return [fruit for kept in self._fruit.values() for fruit in kept]
+
     def _unmeasured_parent(self, lane: int, summary: PulseSummary) -> Verdict:
         """The verdict on a contact that no measured contact claims as its rebound: the rebound of a fruit hidden
         in an earlier overlap of the lane (``rebounds.judge_unmeasured``), or a new fruit.  The caller removes the
@@ -439,7 +448,7 @@ class LineAnalyzer:
         limit = self.analysis.flight_limit
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
-        fruit = self._fruit.get(lane, [])
+        fruit = self._lane_fruit(lane)
         verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.analysis.velocity)
                     for sequence, onset, _ in reversed(recent)]
         return min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
@@ -625,10 +634,12 @@ def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
     from fruitimpact.signals.fit import fit_impact
 
     time = (impact.window_start + np.arange(impact.window.size)) / analysis.rate
+    # a window that stops where the next contact of the lane rises (``isolated``) may stop before this one's tail
+    cut = impact.next_start is not None and impact.window_start + impact.window.size <= impact.next_start
     try:
         return fit_impact(time, impact.window, velocity=1.0 if analysis.mass is None else None,
                           mass=analysis.mass, diameter=analysis.diameter, poisson=analysis.poisson,
-                          noise=impact.noise or None)
+                          noise=impact.noise or None, open_end=cut)
     except ValueError as exc:  # one bad pulse never stops the others
         return {"converged": False, "message": f"fit refused: {exc}"}
 

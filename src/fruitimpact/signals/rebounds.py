@@ -408,9 +408,28 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
                         virtual=True)
 
 
-#: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 3 degrees of freedom
-#: (``judge_unmeasured`` adds its three tests).
-FLIGHT_TOLERANCE_SD, CHI2_3_99 = 2.0, 11.345
+#: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 4 degrees of freedom
+#: (``judge_unmeasured`` adds its four tests).
+FLIGHT_TOLERANCE_SD, CHI2_4_99 = 2.0, 13.277
+#: Least spread (sd of ln) of the contact stiffness of a lane's fruit (``judge_unmeasured``): a lot's impact
+#: modulus varies by 10–25 % (sd) and its local radius of curvature adds a few per cent.
+LOT_STIFFNESS_SD = 0.10
+#: The sd of ln K between two spots of one fruit (local radius and modulus ±10 %): a rebound lands elsewhere.
+SPOT_STIFFNESS_SD = 0.10
+
+
+def _log_stiffness(summary: PulseSummary, velocity: float) -> tuple[float, float]:
+    """ln K [N/m^1.5] of the contact if it struck at ``velocity`` [m/s], and its sd: from the Hertz scales (module
+    docstring) δ_H = V t_c/τ_c(x) and K = 1.25 F_max/(P(x) δ_H^1.5).  For one pulse K ∝ V^-1.5: a rebound at
+    r V taken for a fruit at V is 1.5 ln(1/r) (≈ 0.9 at r = 0.55) stiffer in ln K than it is, several times the
+    spread of a lot."""
+    x = summary.x
+    log_k = math.log(1.25 * summary.peak_force / _at("P", x)) \
+        - 1.5 * math.log(velocity * summary.time_to_peak / _at("tc", x))
+    dx = max(summary.x_sd, 1e-3)
+    lo, hi = max(x - dx, 0.0), x + dx
+    slope = (math.log(_at("P", lo) / _at("P", hi)) + 1.5 * math.log(_at("tc", hi) / _at("tc", lo))) / (hi - lo)
+    return log_k, math.sqrt(summary.peak_force_sd ** 2 + (1.5 * summary.time_to_peak_sd) ** 2 + (slope * dx) ** 2)
 #: Fewest measured fruit of a lane before a contact can be judged the rebound of an unmeasured one (their
 #: medians and spreads stand for the hidden fruit).
 LANE_FRUIT_MIN = 5
@@ -582,11 +601,16 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     * its restitution is e(r x_lane) (a rebound is slower, so higher), within the lane's spread of x and of r
       and the candidate's own sd;
     * its impulse is I_lane r (1 + e_r)/(1 + e_lane), within the lane's spread of impulse (the fruit's mass)
-      and of r.
+      and of r;
+    * its contact stiffness, read from its pulse at the speed r V (``_log_stiffness``: K ∝ V^-1.5 for one
+      pulse), is the lane's, within the lane's spread (at least ``LOT_STIFFNESS_SD``), a spot's
+      (``SPOT_STIFFNESS_SD``) and 1.5 × that of r.  The impulse weighs the speed through the mass, this test
+      through the modulus, which a lot spreads independently: a lively light fruit has a rebound's
+      restitution and impulse, but at the rebound's speed its pulse would need a fruit far stiffer than the lot.
 
     Each deviation is reported in units of its tolerance (``TOLERANCES["z"]`` sd for the spreads, the flight's
     taken as ``FLIGHT_TOLERANCE_SD`` sd).  Each test alone is loose (the lot's spreads), so the evidence is
-    added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with three degrees of freedom
+    added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with four degrees of freedom
     (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  Without the line's speed or enough
     measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
     if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
@@ -608,34 +632,42 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     impulse_pred = impulse_lane * r * (1.0 + e_pred) / (1.0 + e_lane)
     flight_pred = 2.0 * r * velocity / STANDARD_GRAVITY
     flight = candidate.onset - (hidden_onset + duration)
+    log_k = [_log_stiffness(f, velocity)[0] for f in fruit]
+    k_lane, k_sd = float(np.median(log_k)), max(_robust_sd(log_k), LOT_STIFFNESS_SD)
+    k_rebound, k_meas = _log_stiffness(candidate, r * velocity)
+    k_fruit = k_rebound + 1.5 * math.log(r)  # the same pulse at the line's speed
     deviations = {
         "restitution": abs(candidate.restitution - e_pred) / (z * e_sd),
         "impulse": abs(math.log(candidate.impulse / impulse_pred))
         / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
         "flight": abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) if flight > 0 else math.inf,
+        "stiffness": abs(k_rebound - k_lane)
+        / (z * math.sqrt(k_sd ** 2 + SPOT_STIFFNESS_SD ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
     }
-    # the three tests are independent and each is loose (the lot's spreads), so their evidence is added: the
-    # distance in sd (the flight tolerance taken as 2 sd) against the 99 % point of χ² with 3 degrees of freedom
-    sds = {"restitution": z, "impulse": z, "flight": FLIGHT_TOLERANCE_SD}
+    # the four tests are independent and each is loose (the lot's spreads), so their evidence is added: the
+    # distance in sd (the flight tolerance taken as 2 sd) against the 99 % point of χ² with 4 degrees of freedom
+    sds = {"restitution": z, "impulse": z, "flight": FLIGHT_TOLERANCE_SD, "stiffness": z}
     distance2 = sum((deviations[k] * sds[k]) ** 2 for k in deviations)
-    score = math.sqrt(distance2 / CHI2_3_99) if math.isfinite(distance2) else math.inf
+    score = math.sqrt(distance2 / CHI2_4_99) if math.isfinite(distance2) else math.inf
     evidence = {"unmeasured_parent": hidden, "flight_observed": flight, "flight_predicted": flight_pred,
                 "restitution": candidate.restitution, "restitution_predicted": e_pred, "lane_restitution": e_lane,
                 "impulse": candidate.impulse, "impulse_predicted": impulse_pred, "lane_fruit": len(fruit),
+                "stiffness_at_rebound_speed": math.exp(k_rebound), "lane_stiffness": math.exp(k_lane),
                 "deviations": {k: round(v, 3) if math.isfinite(v) else None for k, v in deviations.items()},
                 "score": round(score, 3) if math.isfinite(score) else None, "threshold": 1.0,
                 "reason": f"contact #{hidden} held a fruit and another pulse landing together and could not be "
                           f"measured; its fruit's rebound, judged from the lane's {len(fruit)} measured fruit"}
     rebound = score <= 1.0
     ambiguous = AMBIGUOUS[0] < score <= AMBIGUOUS[1]
-    # the other explanation: a new fruit of the lane at the line's speed (its restitution and impulse those of
-    # the lane's fruit, within their spread).  Each test above is loose (a rebound's impulse, r (1 + e_r)/(1 + e)
-    # ≈ 0.65 of a fruit's, lies within the lane's 3 sd of mass), so on the two tests both hypotheses share the
-    # rebound must fit better than a new fruit does; otherwise the contact is a new fruit, said to be ambiguous
+    # the other explanation: a new fruit of the lane at the line's speed (its restitution, impulse and stiffness
+    # those of the lane's fruit, within their spread).  Each test above is loose (a rebound's impulse, r (1 + e_r)/
+    # (1 + e) ≈ 0.65 of a fruit's, lies within the lane's 3 sd of mass), so on the three tests both hypotheses share
+    # the rebound must fit better than a new fruit does; otherwise the contact is a new fruit, said to be ambiguous
     e_lane_sd = math.hypot(max(lane.restitution_sd, 1e-3), candidate.restitution_sd)
     new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
-        (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2
-    rebound2 = (deviations["restitution"] * z) ** 2 + (deviations["impulse"] * z) ** 2
+        (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2 + \
+        ((k_fruit - k_lane) / math.hypot(k_sd, k_meas)) ** 2
+    rebound2 = sum((deviations[k] * z) ** 2 for k in ("restitution", "impulse", "stiffness"))
     evidence["new_fruit_distance"] = round(math.sqrt(new_fruit2), 3)
     evidence["rebound_distance"] = round(math.sqrt(rebound2), 3) if math.isfinite(rebound2) else None
     if rebound and not rebound2 < new_fruit2:
