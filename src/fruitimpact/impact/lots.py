@@ -145,8 +145,18 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     given = [name for name, _ in distributions] + list(text)
     check_conflicts(given)
     refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
-    extra, density, described = lot_distributions(text.get("fruit"), [name for name, _ in distributions] + list(fixed),
-                                                  criterion, spreads=spreads)
+    extra, density, described, basis = lot_distributions(text.get("fruit"),
+                                                         [name for name, _ in distributions] + list(fixed),
+                                                         criterion, spreads=spreads)
+    if basis is not None:  # the drawn bruise values are given ones: their rows carry the library's basis
+        own = [name for name, _ in distributions if name in ("bruise_susceptibility", "bruise_energy")]
+        stated = text.get("bruise_basis", INPUTS["bruise_basis"].default if own else basis)
+        if stated != basis:  # one basis per row: the user's value and the library's cannot both keep theirs
+            raise InputError(f"bruise_basis {stated} (of the given {' and '.join(own) or 'bruise values'}) differs from "
+                             f"the {basis} energy the {text.get('fruit') or INPUTS['fruit'].default} library's bruise "
+                             f"values the lot draws were measured on: give the bruise susceptibility and threshold "
+                             f"energy both, or --no-spreads", "bruise_basis")
+        text["bruise_basis"] = basis
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
     return source, text, tuple(described)
 

@@ -157,11 +157,16 @@ def resolve(inputs, default_restitution: float) -> Resolved:
     return Resolved(dict(defaults), surface_model, restitution, no_threshold, missing, fruit_of, impact_basis)
 
 
-#: The properties a lot draws from its fruit's library spreads (issue 14 item 4), in this order; the
-#: diameter follows the mass at the fruit's density where the library has one.
-LOT_SPREADS = ("mass", "diameter", "modulus", "failure_stress", "bruise_susceptibility")
+#: The inputs a lot draws from its fruit's library spreads (issue 14 item 4), in this order (each the library field
+#: of ``FRUIT_FIELD_INPUTS``); the diameter follows the mass at the fruit's density where the library has one.
+LOT_SPREADS = ("mass", "diameter", "modulus", "failure_stress", "bruise_susceptibility", "bruise_energy")
 #: Those that only a bruise criterion uses (not drawn without one).
-_BRUISE_SPREADS = ("failure_stress", "bruise_susceptibility")
+_BRUISE_SPREADS = ("failure_stress", "bruise_susceptibility", "bruise_energy")
+#: Those that only the energy criterion uses: the threshold energy is its onset (under a stress criterion the onset
+#: is the failure stress's, and drawing it would only print a spread nothing reads).  A fruit-to-fruit spread of it
+#: is what a lab's drop tests give (``fit-damage``: the fruit's thresholds, lognormal), so that a lot near onset is
+#: bruised in part, as drop tests see, not all or none.
+_ENERGY_SPREADS = ("bruise_energy",)
 
 
 @dataclass(frozen=True)
@@ -169,18 +174,23 @@ class LotSpreads:
     """What a lot of ``fruit`` varies by default: ``distributions`` ((input name, distribution) pairs: each a
     split normal with its median at the library's value and each side's sd half the distance to that end of
     the library range, truncated to the range), ``diameter_density`` (the density [kg/m³] each fruit's
-    diameter follows its mass at, or None) and ``described``: one line per property, for the output."""
+    diameter follows its mass at, or None), ``described``: one line per property, for the output, and
+    ``bruise_basis``: the energy basis (``impact`` or ``absorbed``) the drawn bruise values were measured on in the
+    library, or None when none is drawn (the lot's rows must carry it: a drawn value is a given one, and a given
+    value's basis is ``bruise_basis``'s)."""
 
     fruit: str
     distributions: tuple
     diameter_density: float | None
     described: tuple
+    bruise_basis: str | None = None
 
 
-def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
+def lot_spreads(fruit: str, fixed, bruise: bool = True, energy: bool = False) -> LotSpreads:
     """The library spreads a lot of ``fruit`` is drawn from, leaving out the inputs in ``fixed`` (those the
     user gave, as constants or distributions; a given ``stiffness`` fixes the contact, so the modulus is not
-    drawn) and, without a bruise criterion (``bruise`` False), the failure stress and susceptibility.  A
+    drawn), without a bruise criterion (``bruise`` False) the failure stress, susceptibility and threshold
+    energy, and the threshold energy unless the criterion is ``energy`` (``energy`` True).  A
     property whose library range is one value stays that value; one the entry lacks is left to the inputs' own
     rules (a criterion needing it is refused).  The diameter follows each fruit's mass (drawn here or given)
     at the library density unless the diameter is given.  ``fruit`` must be a library name."""
@@ -192,12 +202,13 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
     entry = entries[fruit]
     fixed = set(fixed)
     out, lines, density = [], [], None
+    field_of = {input_name: field for field, input_name in FRUIT_FIELD_INPUTS.items()}
     for name in LOT_SPREADS:
-        value = getattr(entry, name)
+        value = getattr(entry, field_of[name])
         if name in fixed:
             lines.append(f"{name}: as given")
             continue
-        if name in _BRUISE_SPREADS and not bruise:
+        if name in _BRUISE_SPREADS and not bruise or name in _ENERGY_SPREADS and not energy:
             continue
         if name == "modulus" and "stiffness" in fixed:
             lines.append("modulus: not drawn (the given stiffness fixes the contact)")
@@ -217,7 +228,11 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True) -> LotSpreads:
         lines.append(f"{name}: median {value.value:g}, sd {low_sd:.3g} below and {high_sd:.3g} above, in "
                      f"[{value.low:g}, {value.high:g}] {value.unit} (the {fruit} library value and range, "
                      f"each side a ±2 sd band)")
-    return LotSpreads(fruit, tuple(out), density, tuple(lines))
+    bases = {entry.bases().get(field_of[name]) for name, _ in out if name in _BRUISE_SPREADS} - {None}
+    if len(bases) > 1:  # one basis per row: the library would have to say which (none does)
+        raise ValueError(f"the {fruit} entry's bruise values are on different energy bases ({', '.join(sorted(bases))}): "
+                         f"give --bruise-susceptibility and --bruise-energy with --bruise-basis")
+    return LotSpreads(fruit, tuple(out), density, tuple(lines), next(iter(bases), None))
 
 
 def fruit_criterion(fruit: str | None, criterion: str | None, task: str = "") -> str:
@@ -254,17 +269,21 @@ assert all(name in INPUTS for name in DAMAGE_DEFAULTS)
 
 
 def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: bool = True):
-    """(extra distributions, diameter density or None, lines describing the spreads) of a lot of ``fruit``
+    """(extra distributions, diameter density or None, lines describing the spreads, the energy basis of the drawn
+    bruise values or None: ``LotSpreads.bruise_basis``) of a lot of ``fruit``
     (the default fruit when None): the library spreads (``lot_spreads``) of the inputs not in ``given``,
     the bruise inputs only with a ``criterion`` (issue 14 item 4); none when ``spreads`` is False (identical
     fruit at the library values).  ValueError naming ``fruit`` for a fruit that is not in the library."""
     fruit = fruit or INPUTS["fruit"].default
     if not spreads:
-        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",)
+        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",), None
     from fruitimpact.impact.validation import InputError
 
     try:
-        lot = lot_spreads(fruit, given, bruise=criterion not in (None, "none"))
+        effective = criterion
+        if criterion == "preset" and fruit in library.fruits():  # the fruit's own (a misspelt fruit: refused below)
+            effective = library.fruits()[fruit].criterion
+        lot = lot_spreads(fruit, given, bruise=criterion not in (None, "none"), energy=effective == "energy")
     except ValueError as exc:
         raise InputError(str(exc), "fruit") from None
     described = lot.described
@@ -273,7 +292,7 @@ def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: 
     if fitted is not None and criterion in ("pressure", "shear") and criterion != fitted and "failure_stress" in drawn:
         # the lot's rows carry the drawn stress as given: the evaluation's warning of it is said here, once
         described += (f"warning: {library.fitted_criterion_message(fruit, fitted, criterion)}",)
-    return lot.distributions, lot.diameter_density, described
+    return lot.distributions, lot.diameter_density, described, lot.bruise_basis
 
 
 __all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "lot_distributions", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",
