@@ -496,12 +496,13 @@ def test_the_bounce_of_a_rebound_hidden_in_an_overlap_is_a_rebound_of_the_overla
 
 
 def test_without_the_lanes_fruit_or_speed_a_hidden_fruits_rebound_is_not_guessed():
-    """Fewer than 5 measured fruit, or no line speed: nothing stands for the hidden fruit, so no decision."""
-    from fruitimpact.signals.rebounds import NEW_FRUIT, judge_unmeasured
+    """Fewer than LANE_FRUIT_MIN measured fruit, or no line speed: nothing stands for the hidden fruit, so no
+    decision."""
+    from fruitimpact.signals.rebounds import LANE_FRUIT_MIN, NEW_FRUIT, judge_unmeasured
 
     hidden = impact()
     back = summary(impact(velocity=hidden["e"] * V_LINE, c=hidden["c"]), 1.1, 99)
-    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(4), V_LINE) is NEW_FRUIT
+    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(LANE_FRUIT_MIN - 1), V_LINE) is NEW_FRUIT
     assert judge_unmeasured(back, 42, 1.0, _lane_fruit(), None) is NEW_FRUIT
 
 
