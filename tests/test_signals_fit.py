@@ -338,39 +338,66 @@ def test_pulse_cut_by_the_window_is_not_converged():
     assert result["converged"] is False and "window" in result["message"]
 
 
-@pytest.mark.parametrize("restitution", [0.45, 0.7])
-def test_a_window_cut_by_the_next_contact_extrapolates_the_tail(restitution):
-    """A fruit landing just after this one ended cuts the window at the detector's offset (3 noise sd): the tail
-    below it, 6 % (e = 0.7) to 16 % (e = 0.45) of a damped Hunt–Crossley pulse, is not sampled.  With
-    ``open_end`` the force law fixed by the rise, peak and fall extrapolates it: the exact engine's pulse is
-    recovered with no bias (mean within 3 standard errors of the mean), its standard error describes its scatter
-    (rms of error/stderr 1.17 at e = 0.45, 0.99 at 0.7; < 1.5 asserted) and the scatter grows by what the tail
-    carried (mean |ΔK| 1.3 → 1.8 % at e = 0.45, unchanged at 0.7; < 2× asserted); without it the fit is refused."""
+def _cut_fits(restitution, noise, seeds):
+    """Per seed: the exact engine's pulse cut at the detector's last sample above 3 noise sd (a following contact
+    rising there), fitted with ``open_end``, and the same pulse's full-window fit."""
     damping = x_of_restitution(restitution) / VELOCITY
     peak = powerlaw_single(MASS, STIFFNESS, 1.5, damping, VELOCITY, DIAMETER / 2)[0]
-    cut_errors, full_errors, unsampled, z = [], [], [], []
-    for seed in range(30):
-        time, force, onset = pulse(seed, damping=damping)
+    rows = []
+    for seed in range(seeds):
+        time, force, onset = pulse(seed, noise=noise, damping=damping, after=400)
         exact = powerlaw_curves(MASS, STIFFNESS, damping, VELOCITY, time - onset)[2]
-        end = int(np.nonzero(exact >= 3 * 0.01 * peak)[0][-1]) + 1  # the detector's last sample above 3 sd
-        cut = fit_impact(time[:end + 1], force[:end + 1], velocity=VELOCITY, open_end=True)
-        if seed < 3:
-            closed = fit_impact(time[:end + 1], force[:end + 1], velocity=VELOCITY)
+        end = int(np.nonzero(exact >= 3 * noise * peak)[0][-1]) + 1
+        cut = fit_impact(time[:end + 1], force[:end + 1], velocity=VELOCITY, open_end=True, noise=noise * peak)
+        full = fit_impact(time, force, velocity=VELOCITY, noise=noise * peak)
+        rows.append((cut, full, time[:end + 1], force[:end + 1]))
+    return rows
+
+
+@pytest.mark.parametrize("restitution,noise", [(0.6, 0.01), (0.7, 0.01), (0.7, 0.03)])
+def test_a_window_cut_by_the_next_contact_extrapolates_the_tail(restitution, noise):
+    """A fruit landing just after this one ended cuts the window at the detector's offset (3 noise sd): the tail
+    below it, 6–14 % of these damped Hunt–Crossley pulses, is not sampled.  Where the samples still fix the damping,
+    ``open_end`` extrapolates it by the force law: the exact engine's K is recovered with no bias (mean within 3
+    standard errors of the mean), a standard error that describes the scatter (rms error/stderr < 1.5; measured
+    0.75–1.0) and a scatter within 1.5 times the full window's (measured 1.0–1.1); without ``open_end`` the fit is
+    refused."""
+    rows = _cut_fits(restitution, noise, 30)
+    errors, z, full_errors = [], [], []
+    for k, (cut, full, time, force) in enumerate(rows):
+        if k < 3:
+            closed = fit_impact(time, force, velocity=VELOCITY)
             assert closed["converged"] is False and "window" in closed["message"]
-        if not cut["converged"]:  # an optimiser that wandered to a longer pulse: refused, never reported
-            assert "after the window" in cut["message"]
+        if not cut["converged"]:
             continue
         assert "not sampled" in cut["message"]
-        cut_errors.append(cut["stiffness"] / STIFFNESS - 1.0)
-        z.append(cut_errors[-1] * STIFFNESS / cut["stiffness_stderr"])
-        full_errors.append(fit_impact(time, force, velocity=VELOCITY)["stiffness"] / STIFFNESS - 1.0)
-        unsampled.append((cut["start_time"] + cut["contact_duration"] - time[end]) / cut["contact_duration"])
-    cut_errors = np.array(cut_errors)
-    assert len(cut_errors) >= 27  # measured 28–30 of 30
-    assert 0.04 < np.mean(unsampled) < 0.2
-    assert abs(np.mean(cut_errors)) < 3 * np.std(cut_errors) / math.sqrt(len(cut_errors))
+        errors.append(cut["stiffness"] / STIFFNESS - 1.0)
+        z.append(errors[-1] * STIFFNESS / cut["stiffness_stderr"])
+        full_errors.append(full["stiffness"] / STIFFNESS - 1.0)
+    errors = np.array(errors)
+    assert len(errors) >= 25  # measured 27–30 of 30
+    assert abs(np.mean(errors)) < 3 * np.std(errors) / math.sqrt(len(errors))
     assert math.sqrt(np.mean(np.square(z))) < 1.5
-    assert np.mean(np.abs(cut_errors)) < 2.0 * np.mean(np.abs(full_errors))
+    assert np.mean(np.abs(errors)) < 1.5 * np.mean(np.abs(full_errors))
+
+
+@pytest.mark.parametrize("restitution,noise", [(0.3, 0.01), (0.35, 0.02), (0.4, 0.02), (0.45, 0.01)])
+def test_a_cut_that_takes_what_fixes_the_damping_is_refused_not_misfitted(restitution, noise):
+    """Below e ≈ 0.45 (and at 2–3 % noise) the tail below 3 sd is 21–37 % of the pulse and holds what fixes the
+    damping: a free fit drifts to a livelier, stiffer pulse (K +12 to +42 %, its stderr covering a third of that)
+    that a restitution 0.05 lower fits as well (Δχ² 0.5–2).  Those are refused ("damping undetermined"), never
+    reported: every fit admitted is within 10 % of K and 5 of its standard errors (worst measured: 7.5 %, 4.3
+    stderr, at e = 0.45), and they average within 2.5 % (at e = 0.45, 1 % noise, where 22–35 of 40–60 are
+    admitted, measured +1.4–1.6 %: the edge of the regime, where the stderr understates the error a little)."""
+    rows = _cut_fits(restitution, noise, 30)
+    admitted = [cut for cut, _, _, _ in rows if cut["converged"]]
+    undetermined = sum("damping undetermined" in cut["message"] for cut, _, _, _ in rows)
+    assert undetermined >= 2
+    errors = np.array([cut["stiffness"] / STIFFNESS - 1.0 for cut in admitted])
+    for cut, error in zip(admitted, errors):
+        assert abs(error) < 0.10 and abs(error) * STIFFNESS < 5 * cut["stiffness_stderr"], cut["message"]
+    if len(errors):
+        assert abs(np.mean(errors)) < 0.025
 
 
 def test_an_open_end_does_not_admit_a_pulse_cut_at_its_middle():

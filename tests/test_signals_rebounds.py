@@ -460,6 +460,8 @@ def test_a_lane_with_few_measured_fruit_is_judged_by_the_fruit_of_every_lane():
     assert analyzer._lane_fruit(0) == analyzer._fruit[0]
     analyzer._fruit[1] = _lane_fruit(LANE_FRUIT_MIN, seed=12)
     assert analyzer._lane_fruit(1) == analyzer._fruit[1]
+    analyzer._fruit = {0: _lane_fruit(8)}  # lane 1 has measured none yet (its first fruit hidden in overlaps)
+    assert analyzer._lane_fruit(1) == analyzer._fruit[0]
     single = Analysis(RATE, fit=True, velocity=V_LINE).analyzer()
     single._fruit = {0: _lane_fruit(2)}
     assert single._lane_fruit(0) == single._fruit[0]  # a line of one lane has only its own

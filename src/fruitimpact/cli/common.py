@@ -226,8 +226,9 @@ class _AfterNumbaImport:
 def add_spread_option(parser) -> None:
     """``--no-spreads``: every member at the fruit's central values (identical fruit)."""
     parser.add_argument("--no-spreads", action="store_true",
-                        help="identical fruit: do not draw mass, size, modulus, failure stress and susceptibility "
-                             "from the fruit's library spreads (by default a lot varies; giving an option fixes it)")
+                        help="identical fruit: do not draw mass, size, modulus, failure stress, susceptibility "
+                             "and (with --criterion energy) threshold energy from the fruit's library spreads (by "
+                             "default a lot varies; giving an option fixes it)")
 
 
 def print_spreads(command: str, lines) -> None:

@@ -145,20 +145,42 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     given = [name for name, _ in distributions] + list(text)
     check_conflicts(given)
     refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
-    extra, density, described, basis = lot_distributions(text.get("fruit"),
+    extra, density, described, bases = lot_distributions(text.get("fruit"),
                                                          [name for name, _ in distributions] + list(fixed),
                                                          criterion, spreads=spreads)
-    if basis is not None:  # the drawn bruise values are given ones: their rows carry the library's basis
-        own = [name for name, _ in distributions if name in ("bruise_susceptibility", "bruise_energy")]
-        stated = text.get("bruise_basis", INPUTS["bruise_basis"].default if own else basis)
-        if stated != basis:  # one basis per row: the user's value and the library's cannot both keep theirs
-            raise InputError(f"bruise_basis {stated} (of the given {' and '.join(own) or 'bruise values'}) differs from "
-                             f"the {basis} energy the {text.get('fruit') or INPUTS['fruit'].default} library's bruise "
-                             f"values the lot draws were measured on: give the bruise susceptibility and threshold "
-                             f"energy both, or --no-spreads", "bruise_basis")
-        text["bruise_basis"] = basis
+    if bases:
+        extra, described = _one_bruise_basis(extra, described, dict(bases), distributions, text)
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
     return source, text, tuple(described)
+
+
+def _one_bruise_basis(extra, described, bases: dict, distributions, text: dict):
+    """The drawn library spreads and their description, with the rows' ``bruise_basis`` set in ``text``.
+
+    A drawn bruise value is a given value to the evaluation, and a row's given bruise values share one basis (the
+    text input ``bruise_basis``).  That basis is the user's (their ``--bruise-basis``, or its default for a bruise
+    value they gave), else that of the drawn threshold energy (the energy criterion's onset), else the
+    susceptibility's.  A library value measured on the other basis is not drawn: it stays the library value, which
+    keeps its own basis, and the description says so (never a value applied on a basis it was not measured on)."""
+    own = [name for name, _ in distributions if name in ("bruise_susceptibility", "bruise_energy")]
+    if "bruise_basis" in text:
+        basis, whose = text["bruise_basis"], "the given --bruise-basis"
+    elif own:
+        basis = INPUTS["bruise_basis"].default
+        whose = f"the default --bruise-basis of the given {' and '.join(own)}"
+    else:
+        basis = bases.get("bruise_energy", bases.get("bruise_susceptibility"))
+        whose = "the drawn " + ("bruise_energy" if "bruise_energy" in bases else "bruise_susceptibility")
+    kept, lines = [], list(described)
+    for name, dist in extra:
+        if name in bases and bases[name] != basis:
+            lines = [f"{name}: the library value, not drawn (measured on the {bases[name]} energy; the rows carry "
+                     f"{whose}, {basis})" if line.startswith(f"{name}: ") else line for line in lines]
+            continue
+        kept.append((name, dist))
+    if any(name in bases for name, _ in kept) or own or "bruise_basis" in text:
+        text["bruise_basis"] = basis
+    return tuple(kept), tuple(lines)
 
 
 def lot_details(source: PopulationSource, described) -> dict:

@@ -162,10 +162,11 @@ def resolve(inputs, default_restitution: float) -> Resolved:
 LOT_SPREADS = ("mass", "diameter", "modulus", "failure_stress", "bruise_susceptibility", "bruise_energy")
 #: Those that only a bruise criterion uses (not drawn without one).
 _BRUISE_SPREADS = ("failure_stress", "bruise_susceptibility", "bruise_energy")
-#: Those that only the energy criterion uses: the threshold energy is its onset (under a stress criterion the onset
-#: is the failure stress's, and drawing it would only print a spread nothing reads).  A fruit-to-fruit spread of it
-#: is what a lab's drop tests give (``fit-damage``: the fruit's thresholds, lognormal), so that a lot near onset is
-#: bruised in part, as drop tests see, not all or none.
+#: Those that only the energy criterion draws: the threshold energy is its onset.  Under a stress criterion the
+#: onset is the failure stress's and the volume counts from its W_f; a threshold energy given (and a drawn one is
+#: given) would be counted from instead, so drawing it there would change the bruise volumes, not only print a
+#: spread.  A fruit-to-fruit spread of it is what a lab's drop tests give (``fit-damage``: the fruit's thresholds,
+#: lognormal), so that a lot near onset is bruised in part, as drop tests see, not all or none.
 _ENERGY_SPREADS = ("bruise_energy",)
 
 
@@ -175,15 +176,15 @@ class LotSpreads:
     split normal with its median at the library's value and each side's sd half the distance to that end of
     the library range, truncated to the range), ``diameter_density`` (the density [kg/m³] each fruit's
     diameter follows its mass at, or None), ``described``: one line per property, for the output, and
-    ``bruise_basis``: the energy basis (``impact`` or ``absorbed``) the drawn bruise values were measured on in the
-    library, or None when none is drawn (the lot's rows must carry it: a drawn value is a given one, and a given
-    value's basis is ``bruise_basis``'s)."""
+    ``bruise_bases``: for each drawn bruise value (input name), the energy basis (``impact`` or ``absorbed``) the
+    library records it was measured on (the lot's rows must carry it: a drawn value is a given one, and a given
+    value's basis is ``bruise_basis``'s; ``impact.lots.read_lot``)."""
 
     fruit: str
     distributions: tuple
     diameter_density: float | None
     described: tuple
-    bruise_basis: str | None = None
+    bruise_bases: tuple = ()
 
 
 def lot_spreads(fruit: str, fixed, bruise: bool = True, energy: bool = False) -> LotSpreads:
@@ -228,11 +229,9 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True, energy: bool = False) ->
         lines.append(f"{name}: median {value.value:g}, sd {low_sd:.3g} below and {high_sd:.3g} above, in "
                      f"[{value.low:g}, {value.high:g}] {value.unit} (the {fruit} library value and range, "
                      f"each side a ±2 sd band)")
-    bases = {entry.bases().get(field_of[name]) for name, _ in out if name in _BRUISE_SPREADS} - {None}
-    if len(bases) > 1:  # one basis per row: the library would have to say which (none does)
-        raise ValueError(f"the {fruit} entry's bruise values are on different energy bases ({', '.join(sorted(bases))}): "
-                         f"give --bruise-susceptibility and --bruise-energy with --bruise-basis")
-    return LotSpreads(fruit, tuple(out), density, tuple(lines), next(iter(bases), None))
+    bases = tuple((name, entry.bases()[field_of[name]]) for name, _ in out
+                  if name in _BRUISE_SPREADS and field_of[name] in entry.bases())
+    return LotSpreads(fruit, tuple(out), density, tuple(lines), bases)
 
 
 def fruit_criterion(fruit: str | None, criterion: str | None, task: str = "") -> str:
@@ -269,14 +268,14 @@ assert all(name in INPUTS for name in DAMAGE_DEFAULTS)
 
 
 def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: bool = True):
-    """(extra distributions, diameter density or None, lines describing the spreads, the energy basis of the drawn
-    bruise values or None: ``LotSpreads.bruise_basis``) of a lot of ``fruit``
+    """(extra distributions, diameter density or None, lines describing the spreads, the energy basis of each drawn
+    bruise value: ``LotSpreads.bruise_bases``) of a lot of ``fruit``
     (the default fruit when None): the library spreads (``lot_spreads``) of the inputs not in ``given``,
     the bruise inputs only with a ``criterion`` (issue 14 item 4); none when ``spreads`` is False (identical
     fruit at the library values).  ValueError naming ``fruit`` for a fruit that is not in the library."""
     fruit = fruit or INPUTS["fruit"].default
     if not spreads:
-        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",), None
+        return (), None, (f"identical {fruit} fruit (--no-spreads): each input at its library value",), ()
     from fruitimpact.impact.validation import InputError
 
     try:
@@ -292,7 +291,7 @@ def lot_distributions(fruit: str | None, given, criterion: str | None, spreads: 
     if fitted is not None and criterion in ("pressure", "shear") and criterion != fitted and "failure_stress" in drawn:
         # the lot's rows carry the drawn stress as given: the evaluation's warning of it is said here, once
         described += (f"warning: {library.fitted_criterion_message(fruit, fitted, criterion)}",)
-    return lot.distributions, lot.diameter_density, described, lot.bruise_basis
+    return lot.distributions, lot.diameter_density, described, lot.bruise_bases
 
 
 __all__ = ["DAMAGE_DEFAULTS", "HALF_SPACE", "LAYER", "fruit_criterion", "lot_distributions", "LOT_SPREADS", "LotSpreads", "Resolved", "effective_mass",

@@ -437,7 +437,7 @@ class LineAnalyzer:
         ``LANE_FRUIT_MIN``, those of every lane (one lot on one line, landing at the one speed the analysis is
         given: a lane just started, or one whose first fruit were hidden in overlaps, is judged by the line's)."""
         own = self._fruit.get(lane, [])
-        if len(own) >= LANE_FRUIT_MIN or len(self._fruit) <= 1:
+        if len(own) >= LANE_FRUIT_MIN or not any(other != lane for other in self._fruit):
             return own
         return [fruit for kept in self._fruit.values() for fruit in kept]
 

@@ -412,17 +412,17 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
 #: (``judge_unmeasured`` adds its four tests).
 FLIGHT_TOLERANCE_SD, CHI2_4_99 = 2.0, 13.277
 #: Least spread (sd of ln) of the contact stiffness of a lane's fruit (``judge_unmeasured``): a lot's impact
-#: modulus varies by 10–25 % (sd) and its local radius of curvature adds a few per cent.
+#: modulus varies by 10–25 % (sd) and its local radius of curvature adds a few per cent.  Each measured fruit was
+#: read on one spot of its own, so the lane's spread already holds the spot-to-spot part a rebound (landing on
+#: another spot of the hidden fruit) adds.
 LOT_STIFFNESS_SD = 0.10
-#: The sd of ln K between two spots of one fruit (local radius and modulus ±10 %): a rebound lands elsewhere.
-SPOT_STIFFNESS_SD = 0.10
 
 
 def _log_stiffness(summary: PulseSummary, velocity: float) -> tuple[float, float]:
     """ln K [N/m^1.5] of the contact if it struck at ``velocity`` [m/s], and its sd: from the Hertz scales (module
-    docstring) δ_H = V t_c/τ_c(x) and K = 1.25 F_max/(P(x) δ_H^1.5).  For one pulse K ∝ V^-1.5: a rebound at
-    r V taken for a fruit at V is 1.5 ln(1/r) (≈ 0.9 at r = 0.55) stiffer in ln K than it is, several times the
-    spread of a lot."""
+    docstring) δ_H = V t_c/τ_c(x) and K = 1.25 F_max/(P(x) δ_H^1.5).  For one pulse K ∝ V^-1.5: a fruit at V read
+    as a rebound at r V looks r^-1.5 (≈ 2.4 at r = 0.55; 0.9 in ln K) stiffer than it is, and a rebound read as a
+    fruit at V as much softer: several times the spread of a lot."""
     x = summary.x
     log_k = math.log(1.25 * summary.peak_force / _at("P", x)) \
         - 1.5 * math.log(velocity * summary.time_to_peak / _at("tc", x))
@@ -607,15 +607,17 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     * its impulse is I_lane r (1 + e_r)/(1 + e_lane), within the lane's spread of impulse (the fruit's mass)
       and of r;
     * its contact stiffness, read from its pulse at the speed r V (``_log_stiffness``: K ∝ V^-1.5 for one
-      pulse), is the lane's, within the lane's spread (at least ``LOT_STIFFNESS_SD``), a spot's
-      (``SPOT_STIFFNESS_SD``) and 1.5 × that of r.  The impulse weighs the speed through the mass, this test
+      pulse), is the lane's, within the lane's spread (at least ``LOT_STIFFNESS_SD``; it holds the spot-to-spot
+      part) and 1.5 × that of r.  The impulse weighs the speed through the mass, this test
       through the modulus, which a lot spreads independently: a lively light fruit has a rebound's
       restitution and impulse, but at the rebound's speed its pulse would need a fruit far stiffer than the lot.
 
     Each deviation is reported in units of its tolerance (``TOLERANCES["z"]`` sd for the spreads, the flight's
     taken as ``FLIGHT_TOLERANCE_SD`` sd).  Each test alone is loose (the lot's spreads), so the evidence is
     added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with four degrees of freedom
-    (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  Without the line's speed or enough
+    (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  The tests share r (a wrong r moves the flight,
+    the impulse and the stiffness together), so that point is a scale chosen on the line recordings of
+    tests/linegen.py, not a calibrated probability.  Without the line's speed or enough
     measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
     if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
         return NEW_FRUIT
@@ -639,17 +641,16 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     log_k = [_log_stiffness(f, velocity)[0] for f in fruit]
     k_lane, k_sd = float(np.median(log_k)), max(_robust_sd(log_k), LOT_STIFFNESS_SD)
     k_rebound, k_meas = _log_stiffness(candidate, r * velocity)
-    k_fruit = k_rebound + 1.5 * math.log(r)  # the same pulse at the line's speed
+    k_fruit = _log_stiffness(candidate, velocity)[0]  # the same pulse read as a fruit at the line's speed
     deviations = {
         "restitution": abs(candidate.restitution - e_pred) / (z * e_sd),
         "impulse": abs(math.log(candidate.impulse / impulse_pred))
         / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
         "flight": abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) if flight > 0 else math.inf,
-        "stiffness": abs(k_rebound - k_lane)
-        / (z * math.sqrt(k_sd ** 2 + SPOT_STIFFNESS_SD ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
+        "stiffness": abs(k_rebound - k_lane) / (z * math.sqrt(k_sd ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
     }
-    # the four tests are independent and each is loose (the lot's spreads), so their evidence is added: the
-    # distance in sd (the flight tolerance taken as 2 sd) against the 99 % point of χ² with 4 degrees of freedom
+    # each test is loose (the lot's spreads), so their evidence is added: the distance in sd (the flight tolerance
+    # taken as 2 sd) against the 99 % point of χ² with 4 degrees of freedom (a scale: the tests share r)
     sds = {"restitution": z, "impulse": z, "flight": FLIGHT_TOLERANCE_SD, "stiffness": z}
     distance2 = sum((deviations[k] * sds[k]) ** 2 for k in deviations)
     score = math.sqrt(distance2 / CHI2_4_99) if math.isfinite(distance2) else math.inf
@@ -676,7 +677,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     evidence["rebound_distance"] = round(math.sqrt(rebound2), 3) if math.isfinite(rebound2) else None
     if rebound and not rebound2 < new_fruit2:
         rebound, ambiguous = False, True
-        evidence["reason"] += "; but a new fruit of the lane fits its restitution and impulse as well or better"
+        evidence["reason"] += "; but a new fruit of the lane fits its restitution, impulse and stiffness as well or better"
     if not rebound and not ambiguous:
         return NEW_FRUIT
     return Verdict(rebound, hidden if rebound else None, ambiguous, r if rebound else None, evidence)
