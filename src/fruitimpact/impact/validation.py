@@ -296,7 +296,11 @@ class WarningBook:
 
     def categories(self) -> tuple[np.ndarray, list[str]]:
         """(codes, categories): each row's joined warning text as a categorical."""
-        unique, codes = np.unique(self.masks, return_inverse=True)
+        masks = self.masks
+        if masks.size and masks.min() == masks.max():  # the common table: every row warned alike (or not at all);
+            unique, codes = masks[:1], np.zeros(masks.size, dtype=np.int64)  # O(n), where a sort took 75 ms/500k
+        else:
+            unique, codes = np.unique(masks, return_inverse=True)
         categories = []
         for mask in unique:
             categories.append("; ".join(t for bit, t in enumerate(self.texts) if int(mask) >> bit & 1))

@@ -97,7 +97,7 @@ def write_part(workdir, index: int, table) -> dict:
     import pyarrow as pa
 
     def write(sink):
-        with pa.ipc.new_file(sink, table.schema) as writer:
+        with pa.ipc.new_file(sink, table.schema, options=pa.ipc.IpcWriteOptions(compression="lz4")) as writer:
             writer.write_table(table)
 
     return _write_file(Path(workdir) / part_name(index), write)
