@@ -565,12 +565,22 @@ def _vector_restitution_of_x_serial(x, out):
 PARALLEL_MIN_ROWS = 2000
 
 
+def _uniform(values: np.ndarray) -> bool:
+    """Every value the same finite number (a table's restitution is often one value: the fruit's or the default),
+    so that a root per row would find one root n times; two passes cost ~1 % of the roots."""
+    return values.shape[0] > PARALLEL_MIN_ROWS and values[0] == values.min() == values.max()
+
+
 def exact_x(restitution):
     """Vectorised ``x_of_restitution``: x = c·v0 from e ∈ (0, 1]."""
     e = np.ascontiguousarray(np.atleast_1d(np.asarray(restitution, dtype=float)).ravel())
     out = np.empty_like(e)
-    kernel = _vector_x_of_restitution if e.shape[0] > PARALLEL_MIN_ROWS else _vector_x_of_restitution_serial
-    kernel(e, _guess_table(), out)
+    if _uniform(e):
+        _vector_x_of_restitution_serial(e[:1], _guess_table(), out[:1])
+        out.fill(out[0])
+    else:
+        kernel = _vector_x_of_restitution if e.shape[0] > PARALLEL_MIN_ROWS else _vector_x_of_restitution_serial
+        kernel(e, _guess_table(), out)
     return out.reshape(np.shape(restitution))
 
 
@@ -578,7 +588,11 @@ def exact_restitution(x):
     """Vectorised ``restitution_of_x``: e from x = c·v0 ≥ 0."""
     xs = np.ascontiguousarray(np.atleast_1d(np.asarray(x, dtype=float)).ravel())
     out = np.empty_like(xs)
-    (_vector_restitution_of_x if xs.shape[0] > PARALLEL_MIN_ROWS else _vector_restitution_of_x_serial)(xs, out)
+    if _uniform(xs):
+        _vector_restitution_of_x_serial(xs[:1], out[:1])
+        out.fill(out[0])
+    else:
+        (_vector_restitution_of_x if xs.shape[0] > PARALLEL_MIN_ROWS else _vector_restitution_of_x_serial)(xs, out)
     return out.reshape(np.shape(x))
 
 
