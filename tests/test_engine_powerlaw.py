@@ -196,3 +196,17 @@ def test_tabulated_batch_path_equals_exact_kernel():
     # ½ m v0² (1 - e²) cancels as e → 1 in both paths alike: compare on the scale ½ m v0²
     np.testing.assert_array_less(np.abs(tab[:, energy] - exact[:, energy]), 1e-14 * 0.5 * m * v * v)
     assert powerlaw.powerlaw_table(1.5)[1] < 1e-12
+
+
+def test_a_uniform_column_gets_the_root_of_its_value_on_every_row():
+    """A column of one restitution (a table's default or a fruit's value) is solved once and filled
+    (``powerlaw._uniform``): every row equals the root of that value solved alone, and e(x) of it returns the
+    value (the exact relation, to 1e-12); a column that differs in one row is solved row by row."""
+    rows = powerlaw.PARALLEL_MIN_ROWS * 3
+    e = np.full(rows, 0.57)
+    x = exact_x(e)
+    assert np.all(x == exact_x(np.array([0.57]))[0])
+    assert np.allclose(exact_restitution(x), 0.57, rtol=0, atol=1e-12)
+    e[rows // 2] = 0.3
+    x = exact_x(e)
+    assert x[rows // 2] == exact_x(np.array([0.3]))[0] and x[0] == exact_x(np.array([0.57]))[0]

@@ -111,3 +111,23 @@ def test_underflow_from_the_cli_is_reported_not_raised(cli):
     status, out, err = cli.run("simulate", "--model", "kelvin-voigt", "--velocity", "1e-160")
     assert status == 1 and "Traceback" not in err
     assert "FAILED" in out and "double precision" in out
+
+
+@pytest.mark.parametrize("distinct", [1, 3, 40])
+def test_warning_categories_group_rows_by_their_set_of_warnings(distinct):
+    """Each row's joined warnings, as a categorical: the same grouping as sorting the rows' sets (np.unique), with
+    few distinct sets (hashed, then coded by comparison) or many (sorted)."""
+    from fruitimpact.impact.validation import WarningBook
+
+    rows = 5000
+    book = WarningBook(rows)
+    rng = np.random.default_rng(distinct)
+    chosen = rng.integers(0, distinct, rows)
+    for k in range(distinct):
+        for bit in range(6):
+            if k >> bit & 1:
+                book.add(chosen == k, f"warning {bit}")
+    codes, categories = book.categories()
+    expected = ["; ".join(f"warning {bit}" for bit in range(6) if k >> bit & 1) for k in chosen]
+    assert [categories[c] for c in codes] == expected
+    assert len(set(categories)) == len(categories)
