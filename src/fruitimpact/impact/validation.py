@@ -299,7 +299,10 @@ class WarningBook:
         masks = self.masks
         # a table's rows carry few distinct warning sets: found by hashing and coded by comparison, O(n) each
         # (sorting 500,000 rows to group them took 75-85 ms a chunk, ~10 % of evaluating it)
-        unique = np.sort(np.unique(masks, sorted=False))
+        try:
+            unique = np.sort(np.unique(masks, sorted=False))  # NumPy >= 2.3 hashes
+        except TypeError:  # an older NumPy (>= 1.26 is supported) has no unsorted unique: it sorts
+            unique = np.unique(masks)
         if unique.size <= 16:
             codes = np.zeros(masks.size, dtype=np.int64)
             for code, mask in enumerate(unique[1:], 1):
