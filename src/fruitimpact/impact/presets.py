@@ -203,9 +203,9 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True, energy: bool = False) ->
     entry = entries[fruit]
     fixed = set(fixed)
     out, lines, density = [], [], None
-    field_of = {input_name: field for field, input_name in FRUIT_FIELD_INPUTS.items()}
     for name in LOT_SPREADS:
-        value = getattr(entry, field_of[name])
+        field = _LIBRARY_KEYS.get(name, name)
+        value = getattr(entry, field)
         if name in fixed:
             lines.append(f"{name}: as given")
             continue
@@ -229,8 +229,9 @@ def lot_spreads(fruit: str, fixed, bruise: bool = True, energy: bool = False) ->
         lines.append(f"{name}: median {value.value:g}, sd {low_sd:.3g} below and {high_sd:.3g} above, in "
                      f"[{value.low:g}, {value.high:g}] {value.unit} (the {fruit} library value and range, "
                      f"each side a ±2 sd band)")
-    bases = tuple((name, entry.bases()[field_of[name]]) for name, _ in out
-                  if name in _BRUISE_SPREADS and field_of[name] in entry.bases())
+    recorded = entry.bases()
+    bases = tuple((name, recorded[_LIBRARY_KEYS.get(name, name)]) for name, _ in out
+                  if name in _BRUISE_SPREADS and _LIBRARY_KEYS.get(name, name) in recorded)
     return LotSpreads(fruit, tuple(out), density, tuple(lines), bases)
 
 

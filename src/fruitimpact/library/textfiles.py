@@ -43,20 +43,20 @@ def _records(numbered) -> list[tuple[int, str]]:
     the end stays one record, with its odd count (``table_lines`` refuses it)."""
     records, pending, first = [], None, 0
     for number, line in numbered:
-        if pending is not None:
-            pending += line
-            if pending.count('"') % 2 == 0:
-                records.append((first, pending))
+        if pending is not None:  # inside a quoted field: its lines are kept apart and joined once it closes
+            pending.append(line)  # (joining as it grows was quadratic: a stray quote early in a 5,000,000-row
+            if line.count('"') % 2:  # log re-read the rest of the file at every line)
+                records.append((first, "".join(pending)))
                 pending = None
             continue
         if not line.strip() or line.lstrip().startswith("#"):
             continue
         if line.count('"') % 2:
-            pending, first = line, number
+            pending, first = [line], number
             continue
         records.append((number, line))
     if pending is not None:
-        records.append((first, pending))
+        records.append((first, "".join(pending)))
     return records
 
 

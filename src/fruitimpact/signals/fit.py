@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from fruitimpact.engine.codes import CONTACT_DURATION, PEAK_FORCE, RESTITUTION, TIME_TO_PEAK
-from fruitimpact.engine.powerlaw import powerlaw_curves, powerlaw_single
+from fruitimpact.engine.powerlaw import exact_x, powerlaw_curves, powerlaw_single, restitution_of_x
 from fruitimpact.signals.leastsquares import fit_pulse_sum, levenberg_marquardt
 from fruitimpact.signals.pulse import STIFFNESS_SCALE, X_MAX, PulseModel, shape_table, table_shape
 
@@ -286,8 +286,10 @@ def fit_impact(time, force, *, velocity=None, mass=None, diameter=None, poisson=
     open_end : bool
         The window was cut short by a following contact (a fruit landing just after this one ended):
         the contact's end may then lie after the last sample, by at most ``OPEN_END_MAX`` of its
-        duration, and is extrapolated by the force law, which the sampled rise, peak and fall fix
-        (noted in ``message``).  False (the default): the end must be sampled.
+        duration, and is extrapolated by the force law, but only where the samples still fix the
+        damping (a restitution ``OPEN_END_DE`` lower must fit worse by ``OPEN_END_EVIDENCE`` in χ²;
+        otherwise ``converged = False``, "damping undetermined"); how much was extrapolated is noted in
+        ``message``.  Not with ``baseline``.  False (the default): the end must be sampled.
 
     Returns
     -------
@@ -457,8 +459,6 @@ def _damping_evidence(ts, ys, weights, theta, model) -> float:
     ``theta`` (the damping fixed there by a stiff prior row, the other parameters refitted): small when the samples
     do not fix the damping (a window cut before the contact's tail).  Without given noise the free fit's residual
     variance is the unit.  A fit with a fitted baseline (``model`` with terms) is not extrapolated: 0."""
-    from fruitimpact.engine.powerlaw import exact_x, restitution_of_x
-
     if theta.size != 4:
         return 0.0
     e_alt = float(restitution_of_x(float(theta[3]))) - OPEN_END_DE
