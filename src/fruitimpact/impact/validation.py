@@ -298,7 +298,7 @@ class WarningBook:
         """(codes, categories): each row's joined warning text as a categorical."""
         masks = self.masks
         # a table's rows carry few distinct warning sets: found by hashing and coded by comparison, O(n) each
-        # (sorting 500,000 rows to group them took 75-85 ms a chunk, ~10 % of evaluating it)
+        # (sorting 500,000 rows to group them took 75-85 ms a chunk: 28 % of evaluating it, in benchmarks/runs.py)
         try:
             unique = np.sort(np.unique(masks, sorted=False))  # NumPy >= 2.3 hashes
         except TypeError:  # an older NumPy (>= 1.26 is supported) has no unsorted unique: it sorts

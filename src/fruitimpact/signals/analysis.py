@@ -634,8 +634,9 @@ def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
     from fruitimpact.signals.fit import fit_impact
 
     time = (impact.window_start + np.arange(impact.window.size)) / analysis.rate
-    # a window that stops where the next contact of the lane rises (``isolated``) may stop before this one's tail
-    cut = impact.next_start is not None and impact.window_start + impact.window.size <= impact.next_start
+    # the detector records the next contact's onset only when it began inside this one's window, and ``isolated``
+    # then stops the window before that contact's rise: possibly before this contact's own tail
+    cut = impact.next_start is not None
     try:
         return fit_impact(time, impact.window, velocity=1.0 if analysis.mass is None else None,
                           mass=analysis.mass, diameter=analysis.diameter, poisson=analysis.poisson,
