@@ -20,7 +20,7 @@ import pytest
 import fruitimpact as fi
 from fruitimpact.handling.line import TransferPoint, read_line
 from fruitimpact.impact.outputs import dump_json
-from test_app import _post, _wait, browser_page, server  # noqa: F401 - server is a fixture
+from test_app import _post, _wait, browser_page, screenshots, server  # noqa: F401 - server is a fixture
 
 pytest.importorskip("tornado")
 from fruitimpact.app import line as page  # noqa: E402 - the app needs tornado's extra
@@ -310,6 +310,13 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
             view.click("[data-export=line]")
         assert download.value.suggested_filename == "line.csv"
         assert read_line(download.value.path()) == _points(line)
+
+        # on a narrow screen the page fits its width: its wide tables scroll inside their panels (before, a hidden
+        # label of the points table and the changes table made the whole page 981 px wide at 700)
+        view.set_viewport_size({"width": 700, "height": 1000})
+        view.wait_for_timeout(200)
+        assert view.evaluate("document.documentElement.scrollWidth") <= 700
+        view.screenshot(path=str(screenshots(tmp_path) / "line-700.png"), full_page=True)
 
 
 

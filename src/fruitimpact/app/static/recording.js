@@ -5,7 +5,8 @@
 const form = document.getElementById("controls");
 const statusLine = document.getElementById("status");
 const results = document.getElementById("results");
-const LANE_COLORS = ["#2f6f4f", "#2b5d9b", "#a35a00", "#7a3e9d", "#b3261e", "#4d7f8c", "#6b6b2f", "#8c4d6b"];
+// neighbouring lanes in colours told apart in thin traces (the first two were a dark green and a dark blue)
+const LANE_COLORS = ["#2b5d9b", "#c4640a", "#2f6f4f", "#b3261e", "#7a3e9d", "#4d7f8c", "#6b6b2f", "#8c4d6b"];
 const CLASS_COLORS = ["#c98b2b", "#6f9f5f", "#2f6f4f", "#2b5d9b", "#7a3e9d", "#444"];
 const SHOWN_ROWS = 2000;  // rows drawn in the table (the CSV has them all)
 let upload = null, last = null, selected = null, sequence = 0, timer = null, limit = 200 * 1024 * 1024;
