@@ -329,7 +329,8 @@ def test_the_recording_page_in_a_real_browser(server, line_recording):
         for attempt in range(4):
             page.click('#impacts tbody tr[data-index="4"]')
             try:
-                _wait(page, "window.fruitimpact.impact !== null && window.fruitimpact.impact.index === 4", 20)
+                _wait(page, "window.fruitimpact.impact !== null && window.fruitimpact.impact.index === 4 && "
+                            "document.getElementById('impact-caption').textContent.startsWith('impact 5 (')", 20)
                 break
             except AssertionError:
                 if attempt == 3:

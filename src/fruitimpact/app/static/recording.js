@@ -75,6 +75,7 @@ async function analyse() {
   draw(answer);
   window.fruitimpact.analyses += 1;
   window.fruitimpact.last = answer;
+  window.fruitimpact.impact = null;  // the impact shown before belongs to the replaced analysis
   statusLine.textContent = `${answer.contacts} contacts analysed in ${((performance.now() - began) / 1000).toFixed(1)} s`;
   if (answer.impacts.length) show(firstFruit(answer));
 }
