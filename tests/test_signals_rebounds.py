@@ -697,3 +697,68 @@ def test_a_rebound_piece_reported_as_an_overlap_carries_no_firmness_of_any_kind(
         for key in ("firmness_c", "firmness_c_star", "raw_firmness_c", "raw_firmness_c_star", "stiffness"):
             assert key not in back or back[key] is None or math.isnan(back[key]), (key, back[key])
         assert back.get("fit_converged") is not True
+
+
+def test_a_pulse_too_light_for_a_fruit_with_a_rebounds_restitution_is_a_rebound():
+    """A fruit lands at the line's speed V and carries the lane's impulse m (1 + e) V with the lane's restitution;
+    a rebound lands at r V (r ≈ 0.92 e) and carries r (1 + e_r)/(1 + e) of it (here 0.58; a second bounce 0.33)
+    with the higher restitution e(r x) of a slower impact.  A pulse that no measured contact claims is such a
+    rebound (its parent not measured as it was) only when both say so (rebounds.too_light_for_fruit): the impulse
+    more than z = 3 sd (sd ≥ LOT_IMPULSE_SD = 0.15) below the lane's and e nearer e(r x) than the lane's e.  A fruit
+    of 0.55 of the lot's mass is as light (ln 0.55 = −4 sd) but has a fruit's restitution: a new fruit.  The
+    rebounds' speeds carry 5 % spin loss beyond r, the margin a real line leaves."""
+    from fruitimpact.signals.rebounds import LANE_FRUIT_MIN, too_light_for_fruit
+
+    fruit = _lane_fruit()
+    parent = impact(restitution=0.57)
+    speed = 0.95 * parent["e"] * V_LINE
+    back = impact(velocity=speed, c=parent["c"])
+    bounce = impact(velocity=0.95 * back["e"] * speed, c=parent["c"])
+    for pulse in (back, bounce):
+        evidence = too_light_for_fruit(summary(pulse, 2.0, 40), fruit)
+        assert evidence is not None and evidence["fruit_distance"] < -3, (pulse, evidence)
+        assert evidence["restitution"] > evidence["lane_fruit_restitution"] + 0.05
+    light = impact(mass=0.55 * MASS, restitution=0.57)
+    assert math.log(light["impulse"] / np.median([f.impulse for f in fruit])) < -3 * 0.15  # as light as a rebound
+    assert too_light_for_fruit(summary(light, 2.0, 40), fruit) is None
+    assert too_light_for_fruit(summary(impact(mass=0.9 * MASS), 2.0, 40), fruit) is None
+    assert too_light_for_fruit(summary(back, 2.0, 40), _lane_fruit(LANE_FRUIT_MIN - 1)) is None
+
+
+def test_rebounds_whose_parent_was_not_measured_are_not_new_fruit():
+    """A fruit's first impact is not on the plate's record as itself (on a line: it landed within a fraction of a
+    millisecond of another fruit's rebound and the two read as one heavier fruit; here, more simply, it struck
+    the plate's frame), then its rebound and its second bounce land on the plate.  No measured contact predicts
+    the rebound, so the rebound tests cannot claim it.  It may not be graded as a new fruit: it is too light for
+    the lot (0.58 of its impulse) and as lively as a rebound (rebounds.too_light_for_fruit), so it is reported a
+    rebound, its parent unknown (rebound_of null), ambiguous, with no class; the second bounce is then the
+    rebound of that rebound.  A light fruit of the lot (0.6 of its mass, its restitution) landing after them is
+    still a new fruit, graded."""
+    from fruitimpact.signals.sort import FirmnessClasses
+
+    lot = [impact(mass=MASS * m, restitution=e) for m, e in ((1.0, 0.57), (1.1, 0.55), (0.92, 0.6), (1.05, 0.58))]
+    onsets = [0.1 + 0.25 * k for k in range(len(lot))]
+    a = impact(restitution=0.58)
+    t_a = onsets[-1] + 0.25  # its impact is not recorded
+    speed = 0.95 * a["e"] * V_LINE
+    back = impact(velocity=speed, c=a["c"])
+    landing = t_a + a["T"] + 2 * speed / G
+    speed_2 = 0.95 * back["e"] * speed
+    bounce = impact(velocity=speed_2, c=a["c"])
+    t_bounce = landing + back["T"] + 2 * speed_2 / G
+    light = impact(mass=0.6 * MASS, restitution=0.57)
+    t_light = t_bounce + 0.2
+    pulses = [*zip(onsets, lot), (landing, back), (t_bounce, bounce), (t_light, light)]
+    x = _signal([p[0] for p in pulses], [p[1] for p in pulses], int((t_light + 0.1) * RATE))
+    reports = _reports(x, classes=FirmnessClasses("stiffness", (STIFFNESS,), ("soft", "firm")))
+    assert len(reports) == len(pulses), [(r["start_time"], r["message"]) for r in reports]
+    assert not any(r["rebound"] for r in reports[:len(lot)])
+    orphan, second = reports[len(lot):len(lot) + 2]
+    assert orphan["status"] == "ok" and orphan["rebound"] and orphan["rebound_of"] is None, orphan["message"]
+    assert orphan["rebound_ambiguous"] and orphan["class"] is None
+    assert "not measured as it was" in orphan["message"]
+    # the second bounce: predicted from the first rebound's own pulse (or, failing that, as light and lively)
+    assert second["rebound"] and second["class"] is None, second["message"]
+    assert second["rebound_of"] in (orphan["sequence"], None)
+    last = reports[-1]
+    assert not last["rebound"] and last["class"] is not None, last["message"]

@@ -81,7 +81,7 @@ def _table_header(analysis) -> str:
 def _table_row(r: dict, analysis) -> str:
     flags = [r["status"]] if r.get("status") != "ok" else []
     if r.get("rebound"):
-        flags.append(f"rebound of #{r['rebound_of']}")
+        flags.append(f"rebound of #{r['rebound_of']}" if r.get("rebound_of") is not None else "rebound (parent unmeasured)")
     if r.get("rebound_ambiguous"):
         flags.append("ambiguous")
     line = (f"{r['lane']:<10}{r['sequence']:>6d}{r['start_time']:>10.5f}{r['peak_force']:>11.4g}{r['time_to_peak'] * 1e3:>10.4g}"

@@ -45,7 +45,7 @@ from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
                                          from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
                                          likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
-                                         shape_table)
+                                         shape_table, too_light_for_fruit)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -365,6 +365,12 @@ class LineAnalyzer:
             together = landed_with_rebound(summary, list(due), lane_fruit)
             found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
             pair, pair_parents = found if found is not None else (None, None)
+        orphan = None
+        if not rebound and status == "ok" and summary is not None and together is None and pair is None:
+            orphan = too_light_for_fruit(summary, self._lane_fruit(impact.lane))
+        if orphan is not None:  # a rebound whose parent's pulse was not measured as it was: not graded
+            rebound, chosen, hidden_fruit = True, None, False
+            message = f"a rebound of a contact not measured as it was: {orphan['reason']}"
         if together is not None:  # one fruit fitted through two pulses would be a wrong grade: no firmness
             status, chosen, summary, hidden_fruit = "overlap", None, None, False
             held = "a rebound" if len(together["parents"]) == 1 else "two rebounds"
@@ -375,7 +381,9 @@ class LineAnalyzer:
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
             _without_firmness(report)
         speed = analysis.velocity
-        if rebound and hidden_fruit:  # a hidden fruit rebounds once
+        if orphan is not None:
+            speed = None  # its speed is not measured: the fit leaves m and K unsplit
+        elif rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
         elif rebound and chosen is not None:
@@ -387,8 +395,8 @@ class LineAnalyzer:
                 else None
         report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound else
                       pair["parents"][0] if pair is not None else None,
-                      rebound_ambiguous=bool(chosen is not None and chosen.ambiguous),
-                      rebound_evidence=chosen.evidence if chosen is not None else together or pair)
+                      rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None),
+                      rebound_evidence=chosen.evidence if chosen is not None else together or pair or orphan)
         if analysis.fit and shape is not None and status != "overlap":
             result = _restated(shape, analysis, speed)
             _merge_fit(report, result)

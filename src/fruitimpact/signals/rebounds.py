@@ -59,7 +59,8 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 __all__ = ["AMBIGUOUS", "LaneFruit", "PulseSummary", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound",
            "from_indices", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
-           "likeliest_hidden", "rebounds_due", "rebounds_landed_together", "refine", "shape_table"]
+           "likeliest_hidden", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
+           "too_light_for_fruit"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
@@ -517,6 +518,41 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
                       f"together carry {(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
                       f"({best['together_distance']:.1f} sd)")
     return best
+
+
+def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> dict | None:
+    """Is ``candidate``, one pulse that no earlier contact claims as its rebound, a rebound all the same?
+
+    Every fruit of a lane lands at the line's one speed V, so it carries the impulse m (1 + e) V of the lane's
+    fruit (the median and robust spread, at least ``LOT_IMPULSE_SD``, of its measured ``fruit``, at least
+    ``LANE_FRUIT_MIN``) and has their restitution e(x), x = c V.  A rebound lands slower, at r V (r ≈ 0.92 e,
+    ``EXPECTED_RATIO``): it carries about r (1 + e_r)/(1 + e) of that impulse (0.3–0.7) and, its x being r
+    times smaller, a higher restitution e_r = e(r x).  A pulse is such a rebound when both point that way: its
+    impulse lies more than ``TOLERANCES["z"]`` sd below the lane's fruit (a fruit that light is improbable) and
+    its restitution nearer e_r than the lane's e (a light fruit of the lot has the lot's restitution).  Its
+    parent is then a contact not measured as it was: a fruit and a rebound landing within a fraction of a
+    millisecond read as one heavier fruit (``landed_with_rebound`` finds it only when the lane's spread of
+    impulse allows), and their rebounds match no prediction.  Returns the evidence or None."""
+    if len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
+        return None
+    z = TOLERANCES["z"]
+    lane = lane_fruit(fruit)
+    impulse_sd = math.hypot(max(lane.impulse_sd, LOT_IMPULSE_SD), candidate.impulse_sd)
+    distance = math.log(candidate.impulse / lane.impulse) / impulse_sd
+    if not distance < -z:
+        return None
+    x_lane = float(np.exp(np.median(np.log([max(f.x, 1e-6) for f in fruit]))))
+    e_rebound = _at("e", EXPECTED_RATIO * lane.restitution * x_lane)
+    if not candidate.restitution > 0.5 * (lane.restitution + e_rebound):
+        return None
+    ratio = candidate.impulse / lane.impulse
+    return {"impulse": candidate.impulse, "lane_fruit_impulse": lane.impulse, "lane_fruit": len(fruit),
+            "fruit_distance": round(distance, 3), "restitution": candidate.restitution,
+            "lane_fruit_restitution": lane.restitution, "rebound_restitution_predicted": e_rebound, "score": None,
+            "reason": (f"one pulse carrying {ratio:.2f} times the impulse of the lane's {len(fruit)} measured fruit "
+                       f"({-distance:.1f} sd below them, at most {z:g}) with a rebound's restitution "
+                       f"({candidate.restitution:.2f}; the lane's fruit {lane.restitution:.2f}, their rebounds "
+                       f"{e_rebound:.2f}), and no earlier contact's predicted rebound")}
 
 
 #: Least spread of the restitution of a lane's fruit and of a predicted rebound's (``rebounds_landed_together``).

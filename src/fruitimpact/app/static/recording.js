@@ -192,7 +192,7 @@ async function show(index) {
   const series = [{x: answer.time, y: answer.force, color: "#5b6775", label: "samples"}];
   if (answer.model) series.push({x: answer.model.time, y: answer.model.force, color: "#b3261e", label: "fitted model"});
   document.getElementById("impact-caption").textContent =
-    `impact ${index + 1} (${row.lane}, at ${fmt(row.start_time, 5)} s)${row.rebound ? `: rebound of #${parentRow(row) + 1}` : ""}` +
+    `impact ${index + 1} (${row.lane}, at ${fmt(row.start_time, 5)} s)${row.rebound ? (parentRow(row) === undefined ? ": rebound of a contact not measured as it was" : `: rebound of #${parentRow(row) + 1}`) : ""}` +
     (answer.model ? ": samples and the fitted Hunt–Crossley model" : last.columns.includes("fit_converged") ? ": the fit did not converge" : ": samples (tick the fit to see the model)");
   Charts.line(document.getElementById("chart-impact"), {series, xLabel: "time in the window [ms]", yLabel: "force [N]"});
   const shown = [["peak_force", "peak force F_max", "N", 1], ["time_to_peak", "time to peak t_c", "ms", 1e3],
