@@ -627,7 +627,8 @@ def score(reports: list[dict], truth: dict, window: float = 1e-3) -> dict:
     * ``overlaps``: reports with ``status == "overlap"``; they are left out of the error statistics and of the
       misflag counts, and ``truth_overlaps`` says how many truth contacts overlap another (for comparison).
     * ``wrong_parent`` (information, not a goal): paired truth rebounds flagged as rebounds whose report's
-      ``rebound_of`` (a ``sequence``) is not the report paired with the truth's parent.
+      ``rebound_of`` (a ``sequence``) is not the report paired with the truth's parent; ``unknown_parent``
+      (information): those whose report names no parent (``rebound_of`` null: a parent not measured as it was).
     Unknown report keys are ignored.
     """
     m = match(reports, truth, window)
@@ -636,9 +637,11 @@ def score(reports: list[dict], truth: dict, window: float = 1e-3) -> dict:
     report_of = {c["index"]: r for c, r in m["pairs"]}
     found = len(m["pairs"]) + len(m["covered"])
     fruit_pairs = [(c, r) for c, r in pairs if not c["is_rebound"]]
-    wrong_parent = 0
+    wrong_parent = unknown_parent = 0
     for c, r in pairs:
-        if c["is_rebound"] and r.get("rebound") and "rebound_of" in r and "sequence" in r:
+        if c["is_rebound"] and r.get("rebound") and "rebound_of" in r and r["rebound_of"] is None:
+            unknown_parent += 1
+        elif c["is_rebound"] and r.get("rebound") and "rebound_of" in r and "sequence" in r:
             parent = report_of.get(c["rebound_of"])
             if parent is None or parent.get("sequence") != r["rebound_of"]:
                 wrong_parent += 1
@@ -663,6 +666,7 @@ def score(reports: list[dict], truth: dict, window: float = 1e-3) -> dict:
         overlaps=sum(1 for r in reports if _is_overlap(r)),
         truth_overlaps=sum(1 for c in contacts if c["overlaps"]),
         wrong_parent=wrong_parent,
+        unknown_parent=unknown_parent,
     )
 
 

@@ -44,7 +44,9 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
         One row per contact in time order per lane, with the columns of ``fruitimpact analyze --json``
         (``lane``, ``start_time`` [s], ``peak_force`` [N], ``time_to_peak`` [s], ``contact_duration`` [s],
         ``firmness_c`` [N/s], ``firmness_c_star`` [N/s²], ``status``, ``rebound_of`` …; with ``fit`` the fitted
-        stiffness, restitution and, with a velocity or mass, the modulus).  ``attrs["warnings"]``: what the
+        stiffness, restitution and, with a velocity or mass, the modulus; ``rebound_of`` is the parent's
+        ``sequence``, NaN for a fruit and for a rebound whose parent was not measured as it was).
+        ``attrs["warnings"]``: what the
         file's reader found odd but could read (a TDMS file cut short), one line each.
 
     Raises

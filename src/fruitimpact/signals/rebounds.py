@@ -412,6 +412,8 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
 #: The flight tolerance of ``TOLERANCES`` as a number of sd, and the 99 % point of χ² with 4 degrees of freedom
 #: (``judge_unmeasured`` adds its four tests).
 FLIGHT_TOLERANCE_SD, CHI2_4_99 = 2.0, 13.277
+#: The 99 % point of χ² with 3 degrees of freedom (``too_light_for_fruit``: restitution, impulse, stiffness).
+CHI2_3_99 = 11.345
 #: Least spread (sd of ln) of the contact stiffness of a lane's fruit (``judge_unmeasured``): a lot's impact
 #: modulus varies by 10–25 % (sd) and its local radius of curvature adds a few per cent.  Each measured fruit was
 #: read on one spot of its own, so the lane's spread already holds the spot-to-spot part a rebound (landing on
@@ -525,14 +527,17 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
 
     Every fruit of a lane lands at the line's one speed V, so it carries the impulse m (1 + e) V of the lane's
     fruit (the median and robust spread, at least ``LOT_IMPULSE_SD``, of its measured ``fruit``, at least
-    ``LANE_FRUIT_MIN``) and has their restitution e(x), x = c V.  A rebound lands slower, at r V (r ≈ 0.92 e,
-    ``EXPECTED_RATIO``): it carries about r (1 + e_r)/(1 + e) of that impulse (0.3–0.7) and, its x being r
-    times smaller, a higher restitution e_r = e(r x).  A pulse is such a rebound when both point that way: its
-    impulse lies more than ``TOLERANCES["z"]`` sd below the lane's fruit (a fruit that light is improbable) and
-    its restitution nearer e_r than the lane's e (a light fruit of the lot has the lot's restitution).  Its
-    parent is then a contact not measured as it was: a fruit and a rebound landing within a fraction of a
-    millisecond read as one heavier fruit (``landed_with_rebound`` finds it only when the lane's spread of
-    impulse allows), and their rebounds match no prediction.  Returns the evidence or None."""
+    ``LANE_FRUIT_MIN``).  A pulse more than ``TOLERANCES["z"]`` sd below that is no likely fruit of the lot:
+    with a 15 % spread, one below 0.64 of the lane's impulse.  Light fruit exist, though, so the pulse must also
+    be what a rebound of one of the lane's fruit would be, on the three tests such a rebound and a new fruit share
+    (``_as_lane_rebound``): its restitution (a rebound lands slower, at r V, so e(r x) is higher), its impulse
+    (I_lane r (1 + e_r)/(1 + e)) and its contact stiffness read at r V (a light lively fruit read at the
+    rebound's speed needs a fruit r^-1.5 times stiffer than the lot), the rebound fitting them within the 99 %
+    point of χ² with three degrees of freedom and better than a new fruit does; as a first rebound (r = ``EXPECTED_RATIO`` e_lane) or a second (r times the same ratio at the
+    first rebound's e).  Its parent is then a contact not measured as it was: a fruit and a rebound landing
+    within a fraction of a millisecond read as one heavier fruit (``landed_with_rebound`` finds it only when the
+    lane's spread of impulse allows), and their rebounds match no prediction.  First rebounds that carry more
+    than 0.64 of the lane's impulse are never caught.  Returns the evidence or None."""
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
         return None
     z = TOLERANCES["z"]
@@ -541,18 +546,30 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
     distance = math.log(candidate.impulse / lane.impulse) / impulse_sd
     if not distance < -z:
         return None
+    first = EXPECTED_RATIO * lane.restitution
     x_lane = float(np.exp(np.median(np.log([max(f.x, 1e-6) for f in fruit]))))
-    e_rebound = _at("e", EXPECTED_RATIO * lane.restitution * x_lane)
-    if not candidate.restitution > 0.5 * (lane.restitution + e_rebound):
+    second = first * EXPECTED_RATIO * _at("e", first * x_lane)
+    # the line's speed cancels from the tests (``_as_lane_rebound``): 1 m/s stands for it, known or not
+    tests = [(bounce, _as_lane_rebound(candidate, fruit, lane, 1.0, r)) for bounce, r in ((1, first), (2, second))]
+    bounce, best = min(tests, key=lambda test: test[1]["rebound2"])
+    if not (best["rebound2"] <= CHI2_3_99 and best["rebound2"] < best["new_fruit2"]):
         return None
     ratio = candidate.impulse / lane.impulse
-    return {"impulse": candidate.impulse, "lane_fruit_impulse": lane.impulse, "lane_fruit": len(fruit),
-            "fruit_distance": round(distance, 3), "restitution": candidate.restitution,
-            "lane_fruit_restitution": lane.restitution, "rebound_restitution_predicted": e_rebound, "score": None,
+    which = "first" if bounce == 1 else "second"
+    return {"kind": "unmeasured_parent", "bounce": bounce, "impulse": candidate.impulse,
+            "lane_fruit_impulse": lane.impulse, "lane_fruit": len(fruit), "fruit_distance": round(distance, 3),
+            "restitution": candidate.restitution, "lane_fruit_restitution": lane.restitution,
+            "restitution_predicted": best["restitution_predicted"],
+            "impulse_predicted": best["impulse_predicted"],
+            "stiffness_at_rebound_speed_over_lane": best["stiffness_at_rebound_speed"] / best["lane_stiffness"],
+            "rebound_distance": round(math.sqrt(best["rebound2"]), 3),
+            "new_fruit_distance": round(math.sqrt(best["new_fruit2"]), 3), "score": None,
             "reason": (f"one pulse carrying {ratio:.2f} times the impulse of the lane's {len(fruit)} measured fruit "
-                       f"({-distance:.1f} sd below them, at most {z:g}) with a rebound's restitution "
-                       f"({candidate.restitution:.2f}; the lane's fruit {lane.restitution:.2f}, their rebounds "
-                       f"{e_rebound:.2f}), and no earlier contact's predicted rebound")}
+                       f"({-distance:.1f} sd below them, at most {z:g}), nearer a {which} rebound of one of them "
+                       f"than a new fruit in restitution ({candidate.restitution:.2f}; the lane's fruit "
+                       f"{lane.restitution:.2f}, such a rebound {best['restitution_predicted']:.2f}), impulse and "
+                       f"stiffness ({math.sqrt(best['rebound2']):.1f} against {math.sqrt(best['new_fruit2']):.1f} "
+                       f"sd), and no earlier contact's predicted rebound")}
 
 
 #: Least spread of the restitution of a lane's fruit and of a predicted rebound's (``rebounds_landed_together``).
@@ -626,6 +643,53 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
                       f"the lane lies {new_fruit:.1f} sd away (e {e_lane:.2f})"}, pair
 
 
+def _as_lane_rebound(candidate: PulseSummary, fruit: list[PulseSummary], lane: LaneFruit, velocity: float,
+                     r: float) -> dict:
+    """The three tests a rebound of one of the lane's fruit and a new fruit of the lane share, for ``candidate``
+    taken as that rebound at r V (r of the line's speed ``velocity`` [m/s]) or as a new fruit at V:
+
+    * its restitution: e(r x_lane) for the rebound (a slower impact, so higher), the lane's e for a new fruit;
+    * its impulse: I_lane r (1 + e_r)/(1 + e_lane) for the rebound, the lane's I for a new fruit;
+    * its contact stiffness read from its pulse at the speed it struck (``_log_stiffness``: K ∝ V^-1.5 for one
+      pulse): at r V the lane's K for a rebound, at V for a new fruit.  The line's speed cancels from both
+      comparisons, so any ``velocity`` gives the same distances.
+
+    Each within the lane's spreads (floored at a lot's: ``LOT_IMPULSE_SD``, ``LOT_RESTITUTION_SD``,
+    ``LOT_STIFFNESS_SD``), r's (``EXPECTED_RATIO_SD`` and the lane's spread of e) and the candidate's own.
+    Returns the deviations of the rebound (in tolerances, ``TOLERANCES["z"]`` sd), the squared distances in sd of
+    both hypotheses (``rebound2``, ``new_fruit2``) and what they compare."""
+    tol = TOLERANCES
+    z = tol["z"]
+    e_lane = lane.restitution
+    log_x = np.log([max(f.x, 1e-6) for f in fruit])
+    x_lane, x_sd = float(np.exp(np.median(log_x))), max(_robust_sd(log_x), tol["shape"])
+    impulse_lane, impulse_sd = lane.impulse, max(lane.impulse_sd, LOT_IMPULSE_SD)
+    r_sd = math.hypot(EXPECTED_RATIO_SD, lane.restitution_sd / e_lane)
+    xr = r * x_lane
+    e_pred = _at("e", xr)
+    de_dlnx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (2.0 * math.log(1.05))
+    e_sd = math.hypot(abs(de_dlnx) * math.hypot(x_sd, r_sd), candidate.restitution_sd)
+    impulse_pred = impulse_lane * r * (1.0 + e_pred) / (1.0 + e_lane)
+    log_k = [_log_stiffness(f, velocity)[0] for f in fruit]
+    k_lane, k_sd = float(np.median(log_k)), max(_robust_sd(log_k), LOT_STIFFNESS_SD)
+    k_rebound, k_meas = _log_stiffness(candidate, r * velocity)
+    k_fruit = _log_stiffness(candidate, velocity)[0]  # the same pulse read as a fruit at the line's speed
+    deviations = {
+        "restitution": abs(candidate.restitution - e_pred) / (z * e_sd),
+        "impulse": abs(math.log(candidate.impulse / impulse_pred))
+        / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
+        "stiffness": abs(k_rebound - k_lane) / (z * math.sqrt(k_sd ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
+    }
+    e_lane_sd = math.hypot(max(lane.restitution_sd, LOT_RESTITUTION_SD), candidate.restitution_sd)
+    new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
+        (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2 + \
+        ((k_fruit - k_lane) / math.hypot(k_sd, k_meas)) ** 2
+    rebound2 = sum((deviations[k] * z) ** 2 for k in ("restitution", "impulse", "stiffness"))
+    return {"r": r, "r_sd": r_sd, "deviations": deviations, "rebound2": rebound2, "new_fruit2": new_fruit2,
+            "restitution_predicted": e_pred, "impulse_predicted": impulse_pred,
+            "stiffness_at_rebound_speed": math.exp(k_rebound), "lane_stiffness": math.exp(k_lane)}
+
+
 def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, fruit: list[PulseSummary],
                      velocity: float | None) -> Verdict:
     """Is ``candidate`` the rebound of a fruit hidden in an earlier contact that could not be measured (contact
@@ -660,55 +724,36 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     tol = TOLERANCES
     z = tol["z"]
     lane = lane_fruit(fruit)
-    e_lane = lane.restitution
-    log_x = np.log([max(f.x, 1e-6) for f in fruit])
-    x_lane, x_sd = float(np.exp(np.median(log_x))), max(_robust_sd(log_x), tol["shape"])
-    impulse_lane, impulse_sd = lane.impulse, max(lane.impulse_sd, LOT_IMPULSE_SD)
     duration = float(np.median([f.separation - f.onset for f in fruit]))
-    r = EXPECTED_RATIO * e_lane
-    r_sd = math.hypot(EXPECTED_RATIO_SD, lane.restitution_sd / e_lane)
-    xr = r * x_lane
-    e_pred = _at("e", xr)
-    de_dlnx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (2.0 * math.log(1.05))
-    e_sd = math.hypot(abs(de_dlnx) * math.hypot(x_sd, r_sd), candidate.restitution_sd)
-    impulse_pred = impulse_lane * r * (1.0 + e_pred) / (1.0 + e_lane)
+    shared = _as_lane_rebound(candidate, fruit, lane, velocity, EXPECTED_RATIO * lane.restitution)
+    r, r_sd = shared["r"], shared["r_sd"]
     flight_pred = 2.0 * r * velocity / STANDARD_GRAVITY
     flight = candidate.onset - (hidden_onset + duration)
-    log_k = [_log_stiffness(f, velocity)[0] for f in fruit]
-    k_lane, k_sd = float(np.median(log_k)), max(_robust_sd(log_k), LOT_STIFFNESS_SD)
-    k_rebound, k_meas = _log_stiffness(candidate, r * velocity)
-    k_fruit = _log_stiffness(candidate, velocity)[0]  # the same pulse read as a fruit at the line's speed
-    deviations = {
-        "restitution": abs(candidate.restitution - e_pred) / (z * e_sd),
-        "impulse": abs(math.log(candidate.impulse / impulse_pred))
-        / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
-        "flight": abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) if flight > 0 else math.inf,
-        "stiffness": abs(k_rebound - k_lane) / (z * math.sqrt(k_sd ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
-    }
+    deviations = dict(shared["deviations"])
+    deviations["flight"] = abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) \
+        if flight > 0 else math.inf
     # each test is loose (the lot's spreads), so their evidence is added: the distance in sd (the flight tolerance
     # taken as 2 sd) against the 99 % point of χ² with 4 degrees of freedom (a scale: the tests share r)
     sds = {"restitution": z, "impulse": z, "flight": FLIGHT_TOLERANCE_SD, "stiffness": z}
-    distance2 = sum((deviations[k] * sds[k]) ** 2 for k in deviations)
+    distance2 = sum((deviations[k] * sds[k]) ** 2 for k in ("restitution", "impulse", "flight", "stiffness"))
     score = math.sqrt(distance2 / CHI2_4_99) if math.isfinite(distance2) else math.inf
     evidence = {"unmeasured_parent": hidden, "flight_observed": flight, "flight_predicted": flight_pred,
-                "restitution": candidate.restitution, "restitution_predicted": e_pred, "lane_restitution": e_lane,
-                "impulse": candidate.impulse, "impulse_predicted": impulse_pred, "lane_fruit": len(fruit),
-                "stiffness_at_rebound_speed": math.exp(k_rebound), "lane_stiffness": math.exp(k_lane),
-                "deviations": {k: round(v, 3) if math.isfinite(v) else None for k, v in deviations.items()},
+                "restitution": candidate.restitution, "restitution_predicted": shared["restitution_predicted"],
+                "lane_restitution": lane.restitution, "impulse": candidate.impulse,
+                "impulse_predicted": shared["impulse_predicted"], "lane_fruit": len(fruit),
+                "stiffness_at_rebound_speed": shared["stiffness_at_rebound_speed"],
+                "lane_stiffness": shared["lane_stiffness"],
+                "deviations": {k: round(deviations[k], 3) if math.isfinite(deviations[k]) else None
+                               for k in ("restitution", "impulse", "flight", "stiffness")},
                 "score": round(score, 3) if math.isfinite(score) else None, "threshold": 1.0,
                 "reason": f"contact #{hidden} held a fruit and another pulse landing together and could not be "
                           f"measured; its fruit's rebound, judged from the lane's {len(fruit)} measured fruit"}
     rebound = score <= 1.0
     ambiguous = AMBIGUOUS[0] < score <= AMBIGUOUS[1]
-    # the other explanation: a new fruit of the lane at the line's speed (its restitution, impulse and stiffness
-    # those of the lane's fruit, within their spread).  Each test above is loose (a rebound's impulse, r (1 + e_r)/
-    # (1 + e) ≈ 0.65 of a fruit's, lies within the lane's 3 sd of mass), so on the three tests both hypotheses share
-    # the rebound must fit better than a new fruit does; otherwise the contact is a new fruit, said to be ambiguous
-    e_lane_sd = math.hypot(max(lane.restitution_sd, LOT_RESTITUTION_SD), candidate.restitution_sd)
-    new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
-        (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2 + \
-        ((k_fruit - k_lane) / math.hypot(k_sd, k_meas)) ** 2
-    rebound2 = sum((deviations[k] * z) ** 2 for k in ("restitution", "impulse", "stiffness"))
+    # the other explanation: a new fruit of the lane at the line's speed (``_as_lane_rebound``): on the three tests
+    # both hypotheses share the rebound must fit better than a new fruit does; otherwise the contact is a new
+    # fruit, said to be ambiguous
+    new_fruit2, rebound2 = shared["new_fruit2"], shared["rebound2"]
     evidence["new_fruit_distance"] = round(math.sqrt(new_fruit2), 3)
     evidence["rebound_distance"] = round(math.sqrt(rebound2), 3) if math.isfinite(rebound2) else None
     if rebound and not rebound2 < new_fruit2:
