@@ -768,3 +768,35 @@ def test_rebounds_whose_parent_was_not_measured_are_not_new_fruit():
     assert second["rebound_of"] == orphan["sequence"], second["rebound_evidence"]
     last = reports[-1]
     assert not last["rebound"] and last["class"] is not None, last["message"]
+
+
+def test_a_fruit_landing_with_the_rebound_of_a_fruit_hidden_in_an_overlap_is_an_overlap():
+    """Three fruit land in one contact (an overlap: no fruit measured); the first one's rebound, the lane's typical
+    fruit at r V (rebounds.unmeasured_fruit), then lands 0.2 ms before a new, heavier fruit.  Fitted as one pulse
+    the two carry 1.7 times a fruit's impulse: more than 3 sd above the lane's (sd floored at 15 %), and within
+    1 sd of a fruit and that rebound together.  No measured contact's rebound is due there, only the hidden
+    fruit's, so without it that contact was one heavy fruit, graded; it is an overlap without firmness or class,
+    its evidence naming the earlier overlap (rebounds.landed_with_rebound).  The other two fruit's rebounds are
+    left out of the signal so that this contact is the only one after the overlap."""
+    from fruitimpact.signals.sort import FirmnessClasses
+
+    lot = [impact(mass=MASS * m, restitution=e) for m, e in ((1.0, 0.57), (1.04, 0.56), (0.96, 0.58), (1.02, 0.57),
+                                                              (0.98, 0.57))]
+    onsets = [0.1 + 0.25 * k for k in range(len(lot))]
+    a, b, c = impact(), impact(mass=0.9 * MASS), impact(mass=0.8 * MASS)
+    t_a = onsets[-1] + 0.25
+    speed = 0.92 * a["e"] * V_LINE
+    back = impact(velocity=speed, c=a["c"])
+    landing = t_a + a["T"] + 2 * speed / G
+    heavy = impact(mass=1.1 * MASS, restitution=0.57)
+    pulses = [*zip(onsets, lot), (t_a, a), (t_a + 0.55 * a["T"], b), (t_a + 1.1 * a["T"], c), (landing, back),
+              (landing + 0.0002, heavy)]
+    x = _signal([p[0] for p in pulses], [p[1] for p in pulses], int((landing + 0.1) * RATE))
+    reports = _reports(x, classes=FirmnessClasses("stiffness", (STIFFNESS,), ("soft", "firm")))
+    assert [r["status"] for r in reports[:len(lot)]] == ["ok"] * len(lot)
+    overlap, together = reports[len(lot):]
+    assert overlap["status"] == "overlap", overlap["message"]
+    assert together["status"] == "overlap" and together["class"] is None, together["message"]
+    assert math.isnan(together["firmness_c"])
+    evidence = together["rebound_evidence"]
+    assert evidence["landed_with_rebound_of"] == overlap["sequence"] and evidence["fruit_distance"] > 3, evidence

@@ -45,7 +45,7 @@ from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
                                          from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
                                          likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
-                                         shape_table, too_light_for_fruit)
+                                         shape_table, too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.sort import FirmnessClasses
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -359,16 +359,21 @@ class LineAnalyzer:
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
-        together = pair = pair_parents = None
-        if not rebound and status == "ok" and summary is not None and due:
+        together = together_parents = pair = pair_parents = None
+        hidden_due = self._hidden_fruit_due(impact.lane, summary) \
+            if not rebound and status == "ok" and summary is not None else []
+        if not rebound and status == "ok" and summary is not None and (due or hidden_due):
             lane_fruit = self._lane_fruit(impact.lane)
-            together = landed_with_rebound(summary, list(due), lane_fruit)
-            found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None else None
+            landed = landed_with_rebound(summary, [*due, *hidden_due], lane_fruit)
+            together, together_parents = landed if landed is not None else (None, None)
+            found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None and due else None
             pair, pair_parents = found if found is not None else (None, None)
         orphan = None
         if not rebound and status == "ok" and summary is not None and together is None and pair is None:
             orphan = too_light_for_fruit(summary, self._lane_fruit(impact.lane))
         if orphan is not None:  # a rebound whose parent's pulse was not measured as it was: not graded
+            if chosen is not None and chosen.evidence:  # a near miss of a known parent, kept as evidence
+                orphan["nearest_parent"] = chosen.evidence
             rebound, chosen, hidden_fruit = True, None, False
             message = f"a rebound of a contact not measured as it was: {orphan['reason']}"
         if together is not None:  # one fruit fitted through two pulses would be a wrong grade: no firmness
@@ -423,9 +428,15 @@ class LineAnalyzer:
         elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
-            likeliest = likeliest_hidden(list(due), report["start_time"])
-            if likeliest is not None:  # at most one rebound hides in an overlap: the one due nearest its onset
-                history.append(hidden_rebound(likeliest, sequence, report["start_time"]))
+            seen = [parent for parent in together_parents or [] if any(parent is h for h in hidden_due)]
+            if seen:  # the rebound of a fruit hidden in an earlier overlap: seen here, its bounce expected from here
+                self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane]
+                                                 if u[0] not in {parent.sequence for parent in seen}]
+                history.append(hidden_rebound(seen[0], sequence, report["start_time"]))
+            else:
+                likeliest = likeliest_hidden(list(due), report["start_time"])
+                if likeliest is not None:  # at most one rebound hides in an overlap: the one due nearest its onset
+                    history.append(hidden_rebound(likeliest, sequence, report["start_time"]))
         elif summary is not None and not rebound and summary.refined:
             self._fruit.setdefault(impact.lane, []).append(summary)
             del self._fruit[impact.lane][:-LANE_FRUIT_KEPT]
@@ -448,6 +459,18 @@ class LineAnalyzer:
         if len(own) >= LANE_FRUIT_MIN or not any(other != lane for other in self._fruit):
             return own
         return [fruit for kept in self._fruit.values() for fruit in kept]
+
+    def _hidden_fruit_due(self, lane: int, summary: PulseSummary) -> list[PulseSummary]:
+        """The fruit hidden in the lane's recent overlaps whose rebound is due during ``summary``'s contact
+        (``rebounds.unmeasured_fruit``: each the lane's typical fruit at the line's speed, landing at the overlap's
+        onset); none without the line's speed or ``LANE_FRUIT_MIN`` measured fruit."""
+        velocity = self.analysis.velocity
+        fruit = self._lane_fruit(lane)
+        if velocity is None or len(fruit) < LANE_FRUIT_MIN:
+            return []
+        hidden = [unmeasured_fruit(fruit, sequence, onset, velocity)
+                  for sequence, onset, _ in self._unmeasured.get(lane, []) if onset < summary.onset]
+        return rebounds_due(summary.onset, summary.separation, hidden, max_flight=self.analysis.flight_limit)
 
     def _unmeasured_parent(self, lane: int, summary: PulseSummary) -> Verdict:
         """The verdict on a contact that no measured contact claims as its rebound: the rebound of a fruit hidden

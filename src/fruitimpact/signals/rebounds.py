@@ -60,7 +60,7 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 __all__ = ["AMBIGUOUS", "LaneFruit", "PulseSummary", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound",
            "from_indices", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
            "likeliest_hidden", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
-           "too_light_for_fruit"]
+           "too_light_for_fruit", "unmeasured_fruit"]
 
 #: Tolerances of the tests (module docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
@@ -387,6 +387,30 @@ def likeliest_hidden(due: list[PulseSummary], onset: float) -> PulseSummary | No
     return min(timed, key=miss, default=None)
 
 
+def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, velocity: float) -> PulseSummary:
+    """The summary of a fruit hidden in contact ``sequence``, an overlap starting at ``onset`` [s] (it held that
+    fruit and another pulse and could not be measured): one of the lane's fruit at the line's speed ``velocity``
+    [m/s], so its pulse is the median of the lane's measured ``fruit`` (at least ``LANE_FRUIT_MIN``) and its
+    spreads theirs, floored at a lot's (as ``judge_unmeasured`` takes it).  Its rebound is then due like a measured
+    fruit's (``rebounds_due``) and can be found landing with the next fruit (``landed_with_rebound``)."""
+    lane = lane_fruit(fruit)
+
+    def median_and_sd(values):
+        logs = np.log(values)
+        return float(np.exp(np.median(logs))), _robust_sd(logs)
+
+    peak, peak_sd = median_and_sd([f.peak_force for f in fruit])
+    tc, tc_sd = median_and_sd([f.time_to_peak for f in fruit])
+    x, x_sd = median_and_sd([max(f.x, 1e-6) for f in fruit])
+    duration = float(np.median([f.separation - f.onset for f in fruit]))
+    return PulseSummary(sequence=sequence, onset=onset, separation=onset + duration, peak_force=peak,
+                        time_to_peak=tc, impulse=lane.impulse, x=x, restitution=lane.restitution,
+                        peak_force_sd=peak_sd, time_to_peak_sd=tc_sd,
+                        impulse_sd=max(lane.impulse_sd, LOT_IMPULSE_SD), x_sd=max(x_sd, TOLERANCES["shape"]) * x,
+                        restitution_sd=max(lane.restitution_sd, LOT_RESTITUTION_SD), velocity=velocity,
+                        refined=True, virtual=True)
+
+
 def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSummary:
     """The summary of ``parent``'s rebound when it landed inside a contact that could not be measured (contact
     ``sequence``, an overlap starting at ``onset`` [s], in which that rebound was due, ``rebounds_due``): the
@@ -472,19 +496,22 @@ def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
 LOT_IMPULSE_SD = 0.15
 
 
-def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit: list[PulseSummary]) -> dict | None:
+def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary],
+                        fruit: list[PulseSummary]) -> tuple[dict, list[PulseSummary]] | None:
     """Is ``candidate``, one pulse judged no rebound, a new fruit and a due rebound that landed together?
 
     Two pulses starting within a fraction of a millisecond add up to one pulse that a single force law fits to
     the noise (no joint fit can part them), and its fit is one fruit of about the sum of their masses and
     stiffnesses: a wrong grade.  What betrays them is what they carry: the impulse m (1 + e) V of a fruit of the
     lane (the median and robust spread, at least ``LOT_IMPULSE_SD``, of its measured ``fruit``, at least
-    ``LANE_FRUIT_MIN``) plus that of the
-    rebound that was ``due`` (``rebounds_due``): the same fruit as its parent at r V_p, r = ``EXPECTED_RATIO``
-    e_p, so I_p r (1 + e_r)/(1 + e_p) ± ``EXPECTED_RATIO_SD``.  They landed together when the impulse lies more
-    than ``TOLERANCES["z"]`` sd above the lane's fruit (a fruit that heavy is improbable) and nearer, in sd, to
-    a fruit and that rebound together.  Returns the evidence (the parent whose rebound it holds, both distances)
-    or None."""
+    ``LANE_FRUIT_MIN``) plus that of the rebound that was ``due`` (``rebounds_due``; a fruit hidden in an earlier
+    overlap is due as the lane's typical fruit, ``unmeasured_fruit``): the same fruit as its parent at r V_p,
+    r = ``EXPECTED_RATIO`` e_p, so I_p r (1 + e_r)/(1 + e_p) ± ``EXPECTED_RATIO_SD``.  They landed together when
+    the impulse lies more than ``TOLERANCES["z"]`` sd above the lane's fruit (a fruit that heavy is improbable)
+    and nearer, in sd, to a fruit and that rebound together.  The time the rebound was predicted to land is no
+    evidence here: on a chain line the feed's pitch is about a rebound's flight, so due rebounds are predicted at
+    new fruit's onsets, and on a pad they never land at all.  Returns (the evidence: the parent whose rebound it
+    holds, both distances; the parents) or None."""
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or not due:
         return None
     z = TOLERANCES["z"]
@@ -493,8 +520,8 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
     fruit_distance = math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)
     if not fruit_distance > z:
         return None
-    best = None
-    impulses = [(parent.sequence, _rebound_pulse(parent)[0]) for parent in due]
+    best = chosen_parents = None
+    impulses = [(parent, _rebound_pulse(parent)[0]) for parent in due]
     # a fruit with one due rebound, or with two (a chain line's fruit, the last one's rebound and the one before's
     # second bounce can land within a millisecond)
     groups = [[one] for one in impulses] + [[a, b] for k, a in enumerate(impulses) for b in impulses[k + 1:]]
@@ -505,7 +532,9 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
                              EXPECTED_RATIO_SD * math.sqrt(sum(impulse ** 2 for _, impulse in group))) / both
         distance = abs(math.log(candidate.impulse / both)) / math.hypot(both_sd, candidate.impulse_sd)
         if best is None or distance < best["together_distance"]:
-            best = {"landed_with_rebound_of": group[0][0], "parents": [sequence for sequence, _ in group],
+            chosen_parents = [parent for parent, _ in group]
+            best = {"landed_with_rebound_of": group[0][0].sequence,
+                    "parents": [parent.sequence for parent in chosen_parents],
                     "impulse": candidate.impulse, "lane_fruit_impulse": impulse_lane,
                     "rebound_impulse_predicted": rebound_impulse, "lane_fruit": len(fruit),
                     "fruit_distance": round(fruit_distance, 3), "together_distance": distance}
@@ -519,7 +548,7 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary], fruit:
                       f"{held} was due; a fruit and {those} "
                       f"together carry {(impulse_lane + best['rebound_impulse_predicted']) / impulse_lane:.2f} times "
                       f"({best['together_distance']:.1f} sd)")
-    return best
+    return best, chosen_parents
 
 
 def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> dict | None:
@@ -533,11 +562,12 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
     (``_as_lane_rebound``): its restitution (a rebound lands slower, at r V, so e(r x) is higher), its impulse
     (I_lane r (1 + e_r)/(1 + e)) and its contact stiffness read at r V (a light lively fruit read at the
     rebound's speed needs a fruit r^-1.5 times stiffer than the lot), the rebound fitting them within the 99 %
-    point of χ² with three degrees of freedom and better than a new fruit does; as a first rebound (r = ``EXPECTED_RATIO`` e_lane) or a second (r times the same ratio at the
-    first rebound's e).  Its parent is then a contact not measured as it was: a fruit and a rebound landing
-    within a fraction of a millisecond read as one heavier fruit (``landed_with_rebound`` finds it only when the
-    lane's spread of impulse allows), and their rebounds match no prediction.  First rebounds that carry more
-    than 0.64 of the lane's impulse are never caught.  Returns the evidence or None."""
+    point of χ² with three degrees of freedom and better than a new fruit does; as a first rebound (r =
+    ``EXPECTED_RATIO`` e_lane) or a second (r times the same ratio at the first rebound's e).  Its parent is then a
+    contact not measured as it was: a fruit and a rebound landing within a fraction of a millisecond read as one
+    heavier fruit (``landed_with_rebound`` finds it only when the lane's spread of impulse allows), and their
+    rebounds match no prediction.  First rebounds that carry more than 0.64 of the lane's impulse are never caught.
+    Returns the evidence or None."""
     if len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
         return None
     z = TOLERANCES["z"]
