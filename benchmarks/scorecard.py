@@ -3,6 +3,7 @@
 One command:
 
     python benchmarks/scorecard.py [--quick] [--markdown FILE] [--scenarios NAME,NAME]
+    python benchmarks/scorecard.py --seeds 1-8 [--scenarios NAME,NAME]    (other lines of the same kinds)
 
 For each scenario of ``tests/linegen.py`` (chain feeding at 7 and 10 fruit/s/lane with ±8 % jitter, pads and
 plates with one or two rebounds whose flight is perturbed by ±10 %, close arrivals, hum + drift + 2–3 kHz plate
@@ -19,6 +20,10 @@ peak), median and p95 |ΔK|/K (fitted stiffness, fruit only), p95 |Δe| (restitu
 0 extra, 0 misflagged, F ≤ 1 %, t_c ≤ 2 %, K ≤ 2 % median and ≤ 5 % p95, e ≤ 0.03).  Then the grading lot
 (``grades``, analysed with ``--diameter --poisson --sort-by modulus --thresholds --classes``): its confusion
 matrix and the share of fruit ≥ 5 % from a threshold that get the right class (goal ≥ 98 %).
+
+``--seeds A-B``: every scenario generated with each of those seeds instead of its own (other lines of the same
+kinds, at benchmark size), two at a time; one line per recording and the totals (recordings short of full recall,
+extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit reported as overlaps).
 
 The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
 """
@@ -145,6 +150,56 @@ def confusion_text(g: dict, markdown: bool = False) -> str:
     return body + ("\n\n" if markdown else "\n") + summary
 
 
+def _seeds(text: str) -> list[int]:
+    """"1-8" or "3,5,9" → the seeds."""
+    seeds = []
+    for part in text.split(","):
+        first, _, last = part.partition("-")
+        seeds += list(range(int(first), int(last or first) + 1))
+    return seeds
+
+
+def sweep(names: list[str], seeds: list[int]) -> int:
+    """Every scenario at every seed (``--seeds``): a line per recording and the totals."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    def one(job):
+        name, seed = job
+        scenario = dataclasses.replace(lg.SCENARIOS[name], seed=seed)
+        with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
+            path, truth = lg.write(scenario, Path(folder), scenario.size)
+            proc = subprocess.run([console_script(), "analyze", str(path), *lg.analyze_options(truth)],
+                                  capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise SystemExit(f"{name} seed {seed}: analyze failed ({proc.returncode}):\n{proc.stderr}")
+        reports = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
+        card = lg.score(reports, truth)
+        pairs = lg.match(reports, truth)["pairs"]
+        card["lone_fruit_overlaps"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
+                                          and r.get("status") == "overlap")
+        return name, seed, card
+
+    keys = ("extra", "fruit_taken_for_rebounds", "rebounds_taken_for_fruit", "lone_fruit_overlaps")
+    totals = dict.fromkeys(keys, 0)
+    short = 0
+    t0 = time.perf_counter()
+    print(f"{'scenario':<10}{'seed':>5}{'contacts':>10}{'recall':>9}{'extra':>7}{'fruit→reb':>11}{'reb→fruit':>11}"
+          f"{'lone fruit as overlap':>23}")
+    with ThreadPoolExecutor(2) as pool:
+        for name, seed, card in pool.map(one, [(n, s) for n in names for s in seeds]):
+            short += card["recall"] < 1.0
+            for key in keys:
+                totals[key] += card[key]
+            print(f"{name:<10}{seed:>5}{card['contacts']:>10}{card['recall']:>9.1%}{card['extra']:>7}"
+                  f"{card['fruit_taken_for_rebounds']:>11}{card['rebounds_taken_for_fruit']:>11}"
+                  f"{card['lone_fruit_overlaps']:>23}", flush=True)
+    print(f"{len(names) * len(seeds)} recordings in {time.perf_counter() - t0:.0f} s ({machine()}): "
+          f"{short} short of full recall; extra {totals['extra']}, fruit taken for rebounds "
+          f"{totals['fruit_taken_for_rebounds']}, rebounds taken for fruit {totals['rebounds_taken_for_fruit']}, "
+          f"lone fruit as overlaps {totals['lone_fruit_overlaps']}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="the tests' small sizes (~20-40 contacts)")
@@ -152,11 +207,19 @@ def main(argv=None) -> int:
     parser.add_argument("--scenarios", metavar="NAMES", help="comma-separated scenarios (default: all)")
     parser.add_argument("--seed", type=int, default=None, metavar="N",
                         help="generate every scenario with this seed instead of its own (other lines of the same kind)")
+    parser.add_argument("--seeds", metavar="A-B", help="every scenario at each of these seeds (e.g. 1-8 or 3,5): "
+                                                         "a line per recording and the totals")
     args = parser.parse_args(argv)
     names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
     unknown = [n for n in names if n not in lg.SCENARIOS]
     if unknown:
         parser.error(f"unknown scenarios {unknown}; known: {', '.join(lg.SCENARIOS)}")
+    if args.seeds:
+        try:
+            seeds = _seeds(args.seeds)
+        except ValueError:
+            parser.error(f"--seeds must be A-B or A,B,…; got {args.seeds!r}")
+        return sweep(names, seeds)
     cards = []
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
