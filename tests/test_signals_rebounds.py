@@ -762,6 +762,7 @@ def test_rebounds_whose_parent_was_not_measured_are_not_new_fruit():
     assert orphan["status"] == "ok" and orphan["rebound"] and orphan["rebound_of"] is None, orphan["message"]
     assert orphan["rebound_ambiguous"] and orphan["class"] is None
     assert "not measured as it was" in orphan["message"]
+    assert orphan["rebound_evidence"]["kind"] == "parent_not_measured"
     assert math.isnan(orphan["mass"]) and math.isnan(orphan["stiffness"])  # its speed is not measured: m, K unsplit
     # the second bounce: judged against the first rebound's own pulse
     assert second["rebound"] and second["class"] is None, second["message"]

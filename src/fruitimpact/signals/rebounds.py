@@ -586,7 +586,7 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
         return None
     ratio = candidate.impulse / lane.impulse
     which = "first" if bounce == 1 else "second"
-    return {"kind": "unmeasured_parent", "bounce": bounce, "impulse": candidate.impulse,
+    return {"kind": "parent_not_measured", "bounce": bounce, "impulse": candidate.impulse,
             "lane_fruit_impulse": lane.impulse, "lane_fruit": len(fruit), "fruit_distance": round(distance, 3),
             "restitution": candidate.restitution, "lane_fruit_restitution": lane.restitution,
             "restitution_predicted": best["restitution_predicted"],
