@@ -215,10 +215,17 @@ def main(argv=None) -> int:
     if unknown:
         parser.error(f"unknown scenarios {unknown}; known: {', '.join(lg.SCENARIOS)}")
     if args.seeds:
+        others = [flag for flag, given in (("--seed", args.seed is not None), ("--quick", args.quick),
+                                           ("--markdown", args.markdown)) if given]
+        if others:
+            parser.error(f"--seeds runs every scenario at benchmark size and prints its own table: not with "
+                         f"{', '.join(others)}")
         try:
             seeds = _seeds(args.seeds)
         except ValueError:
-            parser.error(f"--seeds must be A-B or A,B,…; got {args.seeds!r}")
+            seeds = []
+        if not seeds:
+            parser.error(f"--seeds must be A-B (A ≤ B) or A,B,…; got {args.seeds!r}")
         return sweep(names, seeds)
     cards = []
     t0 = time.perf_counter()

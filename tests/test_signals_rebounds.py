@@ -777,8 +777,9 @@ def test_a_fruit_landing_with_the_rebound_of_a_fruit_hidden_in_an_overlap_is_an_
     the two carry 1.7 times a fruit's impulse: more than 3 sd above the lane's (sd floored at 15 %), and within
     1 sd of a fruit and that rebound together.  No measured contact's rebound is due there, only the hidden
     fruit's, so without it that contact was one heavy fruit, graded; it is an overlap without firmness or class,
-    its evidence naming the earlier overlap (rebounds.landed_with_rebound).  The other two fruit's rebounds are
-    left out of the signal so that this contact is the only one after the overlap."""
+    its evidence naming the earlier overlap (rebounds.landed_with_rebound), and the hidden fruit's second bounce
+    (r ≈ 0.92 e of the first rebound's speed, after its flight) is the rebound of that contact.  The other fruit's
+    rebounds are left out of the signal so that these two contacts are the only ones after the overlap."""
     from fruitimpact.signals.sort import FirmnessClasses
 
     lot = [impact(mass=MASS * m, restitution=e) for m, e in ((1.0, 0.57), (1.04, 0.56), (0.96, 0.58), (1.02, 0.57),
@@ -790,14 +791,19 @@ def test_a_fruit_landing_with_the_rebound_of_a_fruit_hidden_in_an_overlap_is_an_
     back = impact(velocity=speed, c=a["c"])
     landing = t_a + a["T"] + 2 * speed / G
     heavy = impact(mass=1.1 * MASS, restitution=0.57)
+    speed_2 = 0.92 * back["e"] * speed  # the hidden fruit's second bounce
+    bounce = impact(velocity=speed_2, c=a["c"])
+    t_bounce = landing + back["T"] + 2 * speed_2 / G
     pulses = [*zip(onsets, lot), (t_a, a), (t_a + 0.55 * a["T"], b), (t_a + 1.1 * a["T"], c), (landing, back),
-              (landing + 0.0002, heavy)]
-    x = _signal([p[0] for p in pulses], [p[1] for p in pulses], int((landing + 0.1) * RATE))
+              (landing + 0.0002, heavy), (t_bounce, bounce)]
+    x = _signal([p[0] for p in pulses], [p[1] for p in pulses], int((t_bounce + 0.1) * RATE))
     reports = _reports(x, classes=FirmnessClasses("stiffness", (STIFFNESS,), ("soft", "firm")))
     assert [r["status"] for r in reports[:len(lot)]] == ["ok"] * len(lot)
-    overlap, together = reports[len(lot):]
+    overlap, together, second = reports[len(lot):]
     assert overlap["status"] == "overlap", overlap["message"]
     assert together["status"] == "overlap" and together["class"] is None, together["message"]
     assert math.isnan(together["firmness_c"])
     evidence = together["rebound_evidence"]
     assert evidence["landed_with_rebound_of"] == overlap["sequence"] and evidence["fruit_distance"] > 3, evidence
+    # the hidden fruit's rebound was seen there: its second bounce is the rebound of that contact
+    assert second["rebound"] and second["rebound_of"] == together["sequence"], second["rebound_evidence"]

@@ -230,10 +230,10 @@ class LineAnalyzer:
                     indices.update({key: math.nan for key in FIRMNESS_KEYS})
                     reports.append(self._contact(piece, indices, fit, "overlap",
                                                  "a piece of a contact holding three pulses, in which two landed "
-                                                 "together and could not be told apart; no firmness"))
+                                                 "together and could not be told apart; no firmness", piece=True))
                 else:
                     reports.append(self._contact(piece, indices, fit, "ok", f"one of {held} fruit in one contact, "
-                                                 "told apart by a joint fit of the pulses"))
+                                                 "told apart by a joint fit of the pulses", piece=True))
                     spread = _relative_peak_error(fit)
                     if reports[-1]["rebound"] and not spread <= PIECE_PRECISION:
                         # a rebound is graded with its fruit, so the piece stays with its parent, but its amplitude
@@ -323,12 +323,14 @@ class LineAnalyzer:
         return pieces
 
     def _contact(self, impact: DetectedImpact, report: dict, shape: dict | None, status: str, message: str,
-                 due: list[PulseSummary] | tuple = ()) -> dict:
+                 due: list[PulseSummary] | tuple = (), piece: bool = False) -> dict:
         """The rest of a contact's report: the rebound decision, the fit restated, the class.  ``due``: the earlier
-        contacts whose rebound was due in it (``rebounds_due``; none for a piece of a split).  In an overlap
-        their rebounds are taken to have landed there (``rebounds.hidden_rebound``), so that each one's own
-        rebound can be recognised; a single pulse judged a new fruit may be one and a due rebound landing
-        together (``rebounds.landed_with_rebound``): then it is an overlap too."""
+        contacts whose rebound was due in it (``rebounds_due``; none for a ``piece`` of a split, whose pulses the
+        joint fit has already told apart).  In an overlap their rebounds are taken to have landed there
+        (``rebounds.hidden_rebound``), so that each one's own rebound can be recognised; a single pulse judged a
+        new fruit may be one and a due rebound, or the rebound of a fruit hidden in an earlier overlap
+        (``_hidden_fruit_due``), landing together (``rebounds.landed_with_rebound``): then it is an overlap too,
+        and each rebound it holds is seen there."""
         analysis = self.analysis
         sequence = self._sequence.get(impact.lane, 0)
         self._sequence[impact.lane] = sequence + 1
@@ -361,7 +363,7 @@ class LineAnalyzer:
         rebound = chosen is not None and chosen.rebound
         together = together_parents = pair = pair_parents = None
         hidden_due = self._hidden_fruit_due(impact.lane, summary) \
-            if not rebound and status == "ok" and summary is not None else []
+            if not rebound and status == "ok" and summary is not None and not piece else []
         if not rebound and status == "ok" and summary is not None and (due or hidden_due):
             lane_fruit = self._lane_fruit(impact.lane)
             landed = landed_with_rebound(summary, [*due, *hidden_due], lane_fruit)
@@ -428,11 +430,16 @@ class LineAnalyzer:
         elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
-            seen = [parent for parent in together_parents or [] if any(parent is h for h in hidden_due)]
-            if seen:  # the rebound of a fruit hidden in an earlier overlap: seen here, its bounce expected from here
-                self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane]
-                                                 if u[0] not in {parent.sequence for parent in seen}]
-                history.append(hidden_rebound(seen[0], sequence, report["start_time"]))
+            if together is not None:  # the rebounds it holds are seen here (once), their bounces expected from here
+                for parent in together_parents:
+                    if any(parent is hidden for hidden in hidden_due):  # a fruit hidden in an earlier overlap
+                        self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane]
+                                                         if u[0] != parent.sequence]
+                    else:
+                        index = next((i for i, s in enumerate(history) if s is parent), None)
+                        if index is not None:
+                            history[index] = parent.taken()
+                    history.append(hidden_rebound(parent, sequence, report["start_time"]))
             else:
                 likeliest = likeliest_hidden(list(due), report["start_time"])
                 if likeliest is not None:  # at most one rebound hides in an overlap: the one due nearest its onset

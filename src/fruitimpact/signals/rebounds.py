@@ -391,7 +391,8 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
     """The summary of a fruit hidden in contact ``sequence``, an overlap starting at ``onset`` [s] (it held that
     fruit and another pulse and could not be measured): one of the lane's fruit at the line's speed ``velocity``
     [m/s], so its pulse is the median of the lane's measured ``fruit`` (at least ``LANE_FRUIT_MIN``) and its
-    spreads theirs, floored at a lot's (as ``judge_unmeasured`` takes it).  Its rebound is then due like a measured
+    spreads theirs, floored at a lot's (as ``judge_unmeasured`` takes it; the peak's and the time to peak's from the
+    lot's spreads of mass and stiffness through the Hertz scales).  Its rebound is then due like a measured
     fruit's (``rebounds_due``) and can be found landing with the next fruit (``landed_with_rebound``)."""
     lane = lane_fruit(fruit)
 
@@ -403,9 +404,13 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
     tc, tc_sd = median_and_sd([f.time_to_peak for f in fruit])
     x, x_sd = median_and_sd([max(f.x, 1e-6) for f in fruit])
     duration = float(np.median([f.separation - f.onset for f in fruit]))
+    # a lot's own spread, which three fruit cannot measure: Hertz, F_max ∝ m^0.6 K^0.4 and t_c ∝ m^0.4 K^-0.4
+    # at one speed, with the mass spread of the impulse and the stiffness spread of a lot
+    peak_floor = math.hypot(0.6 * LOT_IMPULSE_SD, 0.4 * LOT_STIFFNESS_SD)
+    tc_floor = math.hypot(0.4 * LOT_IMPULSE_SD, 0.4 * LOT_STIFFNESS_SD)
     return PulseSummary(sequence=sequence, onset=onset, separation=onset + duration, peak_force=peak,
                         time_to_peak=tc, impulse=lane.impulse, x=x, restitution=lane.restitution,
-                        peak_force_sd=peak_sd, time_to_peak_sd=tc_sd,
+                        peak_force_sd=max(peak_sd, peak_floor), time_to_peak_sd=max(tc_sd, tc_floor),
                         impulse_sd=max(lane.impulse_sd, LOT_IMPULSE_SD), x_sd=max(x_sd, TOLERANCES["shape"]) * x,
                         restitution_sd=max(lane.restitution_sd, LOT_RESTITUTION_SD), velocity=velocity,
                         refined=True, virtual=True)
