@@ -730,6 +730,26 @@ def test_a_pulse_too_light_for_a_fruit_that_a_rebound_explains_is_a_rebound():
     assert too_light_for_fruit(summary(back, 2.0, 40), _lane_fruit(LANE_FRUIT_MIN - 1)) is None
 
 
+def test_a_light_fruit_of_a_wide_lot_is_not_taken_for_a_rebound():
+    """In a lot spread 3 : 1 in mass and 4 : 1 in contact stiffness, a light fruit (0.3 of the nominal mass, e 0.66,
+    0.7 of the nominal stiffness) is 3.1 sd below the lane's impulse, and the lane's wide spread of stiffness
+    leaves its pulse read at a rebound's speed within reach of the lot: a rebound of a lane fruit lies at 3.0 sd,
+    a new fruit at 4.3.  That is no evidence for a rebound: rebounds.too_light_for_fruit asks for a new fruit
+    ORPHAN_MARGIN = 2 times farther (the rebounds it finds on the line scenarios lie 3.6–11 times nearer a
+    rebound), so the pulse stays a new fruit; with a margin of 1 it would have been taken."""
+    from fruitimpact.signals import rebounds
+
+    rng = np.random.default_rng(0)
+    fruit = [summary(impact(mass=MASS * m, restitution=rng.uniform(0.52, 0.62),
+                            stiffness=STIFFNESS * rng.uniform(0.5, 2.0)), 0.1 * k, k, velocity=V_LINE)
+             for k, m in enumerate(np.exp(rng.uniform(math.log(0.5), math.log(1.6), 12)))]
+    light = summary(impact(mass=0.3 * MASS, restitution=0.66, stiffness=0.7 * STIFFNESS), 2.0, 40)
+    assert rebounds.too_light_for_fruit(light, fruit) is None
+    evidence = rebounds._as_lane_rebound(light, fruit, rebounds.lane_fruit(fruit), 1.0,
+                                         rebounds.EXPECTED_RATIO * rebounds.lane_fruit(fruit).restitution)
+    assert evidence["rebound2"] < evidence["new_fruit2"] < rebounds.ORPHAN_MARGIN ** 2 * evidence["rebound2"]
+
+
 def test_rebounds_whose_parent_was_not_measured_are_not_new_fruit():
     """A fruit's first impact is not on the plate's record as itself (on a line: it landed within a fraction of a
     millisecond of another fruit's rebound and the two read as one heavier fruit; here, more simply, it struck
