@@ -827,27 +827,3 @@ def test_a_fruit_landing_with_the_rebound_of_a_fruit_hidden_in_an_overlap_is_an_
     assert evidence["landed_with_rebound_of"] == overlap["sequence"] and evidence["fruit_distance"] > 3, evidence
     # the hidden fruit's rebound was seen there: its second bounce is the rebound of that contact
     assert second["rebound"] and second["rebound_of"] == together["sequence"], second["rebound_evidence"]
-
-
-def test_a_hidden_fruits_rebound_just_outside_the_band_is_a_rebound_when_a_new_fruit_is_far_worse():
-    """The rebound of a fruit hidden in an overlap whose flight is 1.65 times the predicted one (spin and an
-    off-axis bounce take up to ±25 %, so its score, 1.09, lies just outside the rebound band ≤ 1) but whose
-    restitution, impulse and stiffness read at r V are the same fruit's: a new fruit of the lane lies 9 sd away on
-    those three tests, a rebound 1 sd.  The score is a scale, not a calibrated probability, so with a new fruit
-    ORPHAN_MARGIN = 2 times farther the contact is a rebound, still marked ambiguous with its evidence
-    (rebounds.judge_unmeasured); at twice the flight (score > 1.25) it stays a new fruit.  A new fruit of the
-    lane landing at the same moment stays one."""
-    from fruitimpact.signals.rebounds import judge_unmeasured
-
-    fruit = _lane_fruit()
-    hidden = impact(restitution=0.57)
-    back = impact(velocity=hidden["e"] * V_LINE, c=hidden["c"])
-    left = 1.0 + hidden["T"]
-    flight = 2 * 0.95 * hidden["e"] * V_LINE / G
-    verdict = judge_unmeasured(summary(back, left + 1.65 * flight, 99), 42, 1.0, fruit, V_LINE)
-    assert 1.0 < verdict.evidence["score"] <= 1.25 and verdict.rebound and verdict.ambiguous, verdict.evidence
-    assert verdict.evidence["new_fruit_distance"] >= 2 * verdict.evidence["rebound_distance"]
-    new = judge_unmeasured(summary(impact(mass=0.95 * MASS, restitution=0.58), left + 1.65 * flight, 99), 42, 1.0,
-                           fruit, V_LINE)
-    assert not new.rebound, new.evidence
-    assert not judge_unmeasured(summary(back, left + 2 * flight, 99), 42, 1.0, fruit, V_LINE).rebound

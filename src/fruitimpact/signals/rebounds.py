@@ -557,11 +557,9 @@ def landed_with_rebound(candidate: PulseSummary, due: list[PulseSummary],
 
 
 #: How many times farther (in sd) a new fruit must lie than a rebound of the lane's fruit for ``too_light_for_fruit``
-#: to take a pulse for a rebound, and for ``judge_unmeasured`` to take one whose score lies in the ambiguous band
-#: just outside the rebound's.  Measured on line recordings of tests/linegen.py (six scenarios, seeds 1–8): the
-#: rebounds ``too_light_for_fruit`` found lay 3.6–11 times nearer a rebound than a new fruit, those in the ambiguous
-#: band 2.5–2.8 times, every new fruit in that band nearer a new fruit; light fruit of a lot spread 4 : 1 in mass
-#: (80–320 g, chain7, chain10 and close at seeds 1–4) only 1.28–1.32 times, since a lot that wide spreads the
+#: to take a pulse for a rebound.  Measured on line recordings of tests/linegen.py: the rebounds it found (six
+#: scenarios, seeds 1–8) lay 3.6–11 times nearer a rebound than a new fruit; light fruit of a lot spread 4 : 1 in
+#: mass (80–320 g, chain7, chain10 and close at seeds 1–4) only 1.28–1.32 times, since a lot that wide spreads the
 #: stiffness a rebound would be read at too.
 ORPHAN_MARGIN = 2.0
 
@@ -762,9 +760,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with four degrees of freedom
     (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  The tests share r (a wrong r moves the flight,
     the impulse and the stiffness together), so that point is a scale chosen on the line recordings of
-    tests/linegen.py, not a calibrated probability: a rebound must also fit its restitution, impulse and
-    stiffness better than a new fruit of the lane, and one just outside the band (ambiguous) is a rebound when a
-    new fruit lies ``ORPHAN_MARGIN`` times farther on those three.  Without the line's speed or enough
+    tests/linegen.py, not a calibrated probability.  Without the line's speed or enough
     measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
     if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
         return NEW_FRUIT
@@ -806,13 +802,6 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     if rebound and not rebound2 < new_fruit2:
         rebound, ambiguous = False, True
         evidence["reason"] += "; but a new fruit of the lane fits its restitution, impulse and stiffness as well or better"
-    elif ambiguous and not rebound and new_fruit2 >= ORPHAN_MARGIN ** 2 * rebound2:
-        # just outside the band, but a new fruit lies ORPHAN_MARGIN times farther on the shared tests: the score's
-        # scale is in doubt (it is not a calibrated probability), the comparison is not
-        rebound = True
-        farther = math.sqrt(new_fruit2 / rebound2)
-        evidence["reason"] += (f"; outside the rebound band, but a new fruit of the lane lies {farther:.1f} times "
-                               f"farther in restitution, impulse and stiffness")
     if not rebound and not ambiguous:
         return NEW_FRUIT
     return Verdict(rebound, hidden if rebound else None, ambiguous, r if rebound else None, evidence)
