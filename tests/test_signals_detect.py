@@ -172,7 +172,7 @@ def test_every_impact_found_none_extra(recording, detected):
 def test_rebounds_flagged_and_close_fruit_separate(recording, detected):
     """Rule 1 of issue 13 on a generator with no known drop height (V 0.9–1.1 m/s, e 0.4–0.7 per fruit):
     a rebound is the same fruit (m, K, c) at e V after a flight of 2 e V/g, so its impulse, peak, time to
-    peak and shape follow from its parent's by the Hertz scalings (signals/rebounds.py); a larger fruit
+    peak and shape follow from its parent's by the Hertz scalings (signals/rebounds/); a larger fruit
     2–5 ms after a contact (rule 2) is a separate new fruit, never a rebound, and never fitted through."""
     from fruitimpact.signals.analysis import Analysis
 

@@ -435,7 +435,7 @@ def test_the_rebound_of_a_fruit_hidden_in_an_overlap_is_judged_against_the_lanes
     # a light, lively new fruit landing when the rebound is due (mass 0.77 of the lane's, e 0.66): its impulse and
     # restitution are a rebound's, but read at the rebound's speed r V its pulse needs a fruit r^-1.5 ≈ 2.4 times
     # stiffer than the lot (K ∝ V^-1.5 for one pulse): a new fruit, not even ambiguous
-    from fruitimpact.signals.rebounds import EXPECTED_RATIO, LOT_STIFFNESS_SD, _log_stiffness
+    from fruitimpact.signals.rebounds.lane import EXPECTED_RATIO, LOT_STIFFNESS_SD, _log_stiffness
 
     lively_pulse = summary(impact(mass=0.77 * MASS, restitution=0.66), left + flight, 99)
     lively = judge_unmeasured(lively_pulse, 42, 1.0, fruit, V_LINE)
@@ -745,8 +745,8 @@ def test_a_light_fruit_of_a_wide_lot_is_not_taken_for_a_rebound():
              for k, m in enumerate(np.exp(rng.uniform(math.log(0.5), math.log(1.6), 12)))]
     light = summary(impact(mass=0.3 * MASS, restitution=0.66, stiffness=0.7 * STIFFNESS), 2.0, 40)
     assert rebounds.too_light_for_fruit(light, fruit) is None
-    evidence = rebounds._as_lane_rebound(light, fruit, rebounds.lane_fruit(fruit), 1.0,
-                                         rebounds.EXPECTED_RATIO * rebounds.lane_fruit(fruit).restitution)
+    evidence = rebounds.lane._as_lane_rebound(light, fruit, rebounds.lane_fruit(fruit), 1.0,
+                                              rebounds.EXPECTED_RATIO * rebounds.lane_fruit(fruit).restitution)
     assert evidence["rebound2"] < evidence["new_fruit2"] < rebounds.ORPHAN_MARGIN ** 2 * evidence["rebound2"]
 
 

@@ -1,0 +1,71 @@
+"""Is a contact a new fruit or the rebound of an earlier one?  Decided by the fruit's own physics
+(issue 13, item 1), never by "smaller and soon".
+
+A fruit that leaves the plate at V₂ flies 2 V₂/g (no drag) and lands again as the *same* fruit: the
+same mass m, contact stiffness K and Hunt–Crossley damping factor c (a material constant), at the lower
+speed.  For the force law F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale
+times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
+
+    F_max = K δ_H^1.5 · P(x)/1.25,   t_c = t_H · τ_c(x),   T = t_H · τ_T(x),   ∫F dt = m V (1 + e(x)),
+
+with P, τ_c, τ_T, e the dimensionless peak, time to peak, duration and restitution of the exact engine
+(m = V = 1, K = 1.25).  So if a contact j is the rebound of contact p at the speed ratio r = V_j/V_p:
+
+    x_j = r x_p,
+    F_j / F_p  = r^1.2  · P(r x_p)/P(x_p),
+    t_cj/t_cp  = r^-0.2 · τ_c(r x_p)/τ_c(x_p),
+    I_j / I_p  = r · (1 + e(r x_p))/(1 + e(x_p)),
+
+none of which needs m, K or V.  The impulse ratio gives r (it does not depend on where the fruit lands on
+itself); the peak force, the time to peak and the shape x must then agree with it, r must be the
+restitution of p (r ≈ e_p: the fruit cannot come back faster, and spin or an off-axis bounce take a
+little), and, when p's impact speed is known (the line's drop height, or a fitted velocity), the
+observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
+
+Each test gives a deviation in units of its tolerance; the score S of the hypothesis is the largest.
+Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
+
+* flight: ±25 % (a spinning or off-axis fruit's flight is off by ±10–20 %; the estimate of r adds its
+  own error in quadrature);
+* speed ratio r against e_p: −25 % / +10 % (energy lost to spin and tangential motion lowers the
+  vertical rebound speed, nothing raises it: a fruit cannot come back faster than it left; e_p itself
+  is uncertain: 3 × its relative standard error is added in quadrature);
+* peak force and time to peak: 3 × √(σ_meas² + 4 %²), the 4 % for a rebound landing on another spot
+  of the fruit (local radius and modulus ±10 % move F_max and t_c by ~4 %: both go as K^±0.4);
+* shape: x_j against r x_p within 3 × √(σ_j² + (r σ_p)² + (0.1 r x_p)²).
+
+S ≤ 1: a rebound.  S > 1: a new fruit.  Near the boundary (``AMBIGUOUS`` band) the decision is kept but
+flagged ambiguous, with the evidence (predicted and observed flight and peak).  A known feed
+(``pitch``) is a prior: a contact on the pitch grid of the lane's last fruit needs S ≤ 0.8 to be a
+rebound, one far off the grid S ≤ 1.25; without it the rule above alone decides.
+
+The peak, time to peak and impulse are the raw indices (``from_indices``), the same with or without
+``--fit``, so the decision is too; the fit then splits the Hertz scales at the rebound's speed r V_p.
+The raw shape x is read from h = ∫F dt / (F_max t_c), which for the force law is (1 + e(x))/(P(x) τ_c(x)), a
+function of x alone, increasing up to x ≈ 2.6 (e ≈ 0.35) and flat near its top, so the raw x is weak
+for e ≈ 0.35–0.5 (its uncertainty is propagated).  So where a shape fit of the contact converged (the
+simulator's pulse fitted to its own samples, e ± 0.01 at 1 % noise; ``analysis`` fits every contact,
+with or without ``--fit``) its x, e and separation time replace the raw ones (``refine``).
+
+The package, one module per job: ``pulses`` (what the tests know of a contact, the force law's tables, the
+verdict), ``measured`` (a contact against earlier measured or predicted contacts), ``lane`` (a contact against the
+lane's measured fruit, standing for a fruit that was not measured).
+"""
+
+from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, LANE_FRUIT_MIN,
+                                               LOT_IMPULSE_SD, LOT_STIFFNESS_SD, ORPHAN_MARGIN, PAIR_DISTANCE_MAX,
+                                               PAIR_MARGIN, LaneFruit, judge_unmeasured, landed_with_rebound,
+                                               lane_fruit, rebounds_landed_together, too_light_for_fruit,
+                                               unmeasured_fruit)
+from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
+                                                   claimed_parent, expected_rebound, hidden_rebound, judge,
+                                                   likeliest_hidden, rebounds_due)
+from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
+                                                 from_indices, refine, shape_table)
+
+__all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
+           "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
+           "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "RAW_SD", "TOLERANCES", "Verdict",
+           "claimed_parent", "expected_rebound", "from_indices", "hidden_rebound", "judge", "judge_unmeasured",
+           "landed_with_rebound", "lane_fruit", "likeliest_hidden", "rebounds_due", "rebounds_landed_together",
+           "refine", "shape_table", "too_light_for_fruit", "unmeasured_fruit"]
