@@ -31,7 +31,7 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
 
     peak, peak_sd = median_and_sd([f.peak_force for f in fruit])
     tc, tc_sd = median_and_sd([f.time_to_peak for f in fruit])
-    x, x_sd = median_and_sd([max(f.x, 1e-6) for f in fruit])
+    x, x_sd = lane.x, lane.x_sd
     duration = float(np.median([f.separation - f.onset for f in fruit]))
     # a lot's own spread, which three fruit cannot measure: Hertz, F_max ∝ m^0.6 K^0.4 and t_c ∝ m^0.4 K^-0.4
     # at one speed, with the mass spread of the impulse and the stiffness spread of a lot
@@ -86,20 +86,24 @@ def _robust_sd(values) -> float:
 @dataclass(frozen=True)
 class LaneFruit:
     """What a lane's measured new fruit say of the next one: the median ``impulse`` [N s] and the robust sd of its
-    logarithm, the median ``restitution`` and its robust sd (each caller floors the spreads as its test needs)."""
+    logarithm, the median ``restitution`` and its robust sd, the median shape ``x`` = c V and the robust sd of its
+    logarithm (each caller floors the spreads as its test needs)."""
 
     impulse: float
     impulse_sd: float
     restitution: float
     restitution_sd: float
+    x: float
+    x_sd: float
 
 
 def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
     """The ``LaneFruit`` of the measured ``fruit`` of a lane (``analysis`` keeps the last ``LANE_FRUIT_KEPT``)."""
     log_impulse = np.log([f.impulse for f in fruit])
     restitution = [f.restitution for f in fruit]
+    log_x = np.log([max(f.x, 1e-6) for f in fruit])
     return LaneFruit(float(np.exp(np.median(log_impulse))), _robust_sd(log_impulse), float(np.median(restitution)),
-                     _robust_sd(restitution))
+                     _robust_sd(restitution), float(np.exp(np.median(log_x))), _robust_sd(log_x))
 
 
 #: Least spread (sd of ln) of the impulse of a lane's fruit that ``landed_with_rebound`` assumes: fruit of one
@@ -197,8 +201,7 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
     if not distance < -z:
         return None
     first = EXPECTED_RATIO * lane.restitution
-    x_lane = float(np.exp(np.median(np.log([max(f.x, 1e-6) for f in fruit]))))
-    second = first * EXPECTED_RATIO * _at("e", first * x_lane)
+    second = first * EXPECTED_RATIO * _at("e", first * lane.x)
     # the line's speed cancels from the tests (``_as_lane_rebound``): 1 m/s stands for it, known or not
     tests = [(bounce, _as_lane_rebound(candidate, fruit, lane, 1.0, r)) for bounce, r in ((1, first), (2, second))]
     bounce, best = min(tests, key=lambda test: test[1]["rebound2"])
@@ -298,8 +301,7 @@ def _as_lane_rebound(candidate: PulseSummary, fruit: list[PulseSummary], lane: L
     tol = TOLERANCES
     z = tol["z"]
     e_lane = lane.restitution
-    log_x = np.log([max(f.x, 1e-6) for f in fruit])
-    x_lane, x_sd = float(np.exp(np.median(log_x))), max(_robust_sd(log_x), tol["shape"])
+    x_lane, x_sd = lane.x, max(lane.x_sd, tol["shape"])
     impulse_lane, impulse_sd = lane.impulse, max(lane.impulse_sd, LOT_IMPULSE_SD)
     r_sd = math.hypot(EXPECTED_RATIO_SD, lane.restitution_sd / e_lane)
     xr = r * x_lane
