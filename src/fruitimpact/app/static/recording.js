@@ -146,6 +146,8 @@ const parentRow = (row) => rowOf.get(`${row.lane}\u0000${row.rebound_of}`);
 function cell(row, key, scale, index) {
   if (key === "#") return String(index + 1);
   const value = row[key];
+  // a rebound whose parent was not measured as it was (rebound_of null): said, not left blank like a fruit's
+  if (key === "rebound_of" && row.rebound && (value === undefined || value === null)) return "not measured";
   if (value === undefined || value === null) return key === "rebound_of" || key === "class" ? "" : "–";
   if (key === "rebound_of") { const k = parentRow(row); return k === undefined ? `${row.lane} ${value}` : String(k + 1); }
   if (typeof value === "number" && scale !== null) return fmt(value * scale, 4);
