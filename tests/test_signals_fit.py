@@ -74,7 +74,12 @@ def errors(trials, fit, key, truth, relative=True):
 # ------------------------------------------------------------------------------------------ the model
 
 def test_the_shape_table_matches_the_exact_engine():
-    assert shape_table_error(samples=100) < 1e-6  # of F_max: four orders below a 1 % noise
+    """The tabulated pulse shape against the exact engine (``engine.powerlaw``, its own quadrature) at random
+    (σ, x), in units of the peak: three orders below a 1 % noise over the whole range of x (the worst near
+    X_MAX, e ≈ 0.1, a truncated Chebyshev series converges slowest where the pulse is least smooth) and five
+    orders below it for x ≤ 4 (e ≥ 0.24, every fruit on a plate)."""
+    assert shape_table_error(samples=100) < 1e-5
+    assert shape_table_error(samples=100, seed=2, x_max=4.0) < 1e-7
 
 
 def test_noise_free_pulse_is_recovered_to_the_table_accuracy():
