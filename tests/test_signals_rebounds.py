@@ -827,3 +827,107 @@ def test_a_fruit_landing_with_the_rebound_of_a_fruit_hidden_in_an_overlap_is_an_
     assert evidence["landed_with_rebound_of"] == overlap["sequence"] and evidence["fruit_distance"] > 3, evidence
     # the hidden fruit's rebound was seen there: its second bounce is the rebound of that contact
     assert second["rebound"] and second["rebound_of"] == together["sequence"], second["rebound_evidence"]
+
+
+def _lane_with_rebounds(seed, count=6, flights=None):
+    """``count`` fruit of a lot (masses ±10 %, e 0.55–0.6) 0.25 s apart at the line's speed, each followed by its
+    rebound (the same fruit at e V) after 2 e V/g times a factor within ±10 % (spin, an off-axis bounce), or the
+    factors ``flights``; then the ``_lane_then_fruit_with_rebound`` ending: a fruit whose rebound is due and a
+    new fruit landing 0.05 ms before it.  Returns the new fruit and the signal (2.2 % noise)."""
+    rng = np.random.default_rng(seed)
+    onsets, impacts = [], []
+    for k in range(count):
+        fruit = impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=rng.uniform(0.55, 0.6))
+        back = impact(mass=fruit["m"], velocity=fruit["e"] * V_LINE, c=fruit["c"])
+        onset = 0.1 + 0.25 * k
+        factor = rng.uniform(0.9, 1.1) if flights is None else flights[k]
+        flight = 2 * fruit["e"] * V_LINE / G * factor
+        onsets += [onset, onset + fruit["T"] + flight]
+        impacts += [fruit, back]
+    last = impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=0.57)
+    back = impact(mass=last["m"], velocity=last["e"] * V_LINE, c=last["c"])
+    start = 0.1 + 0.25 * count
+    landing = start + last["T"] + 2 * last["e"] * V_LINE / G
+    new = impact(mass=MASS, restitution=0.57)
+    onsets += [start, landing - 5e-5, landing]
+    impacts += [last, new, back]
+    x = _signal(onsets, impacts, int((landing + 0.05) * RATE), seed=seed)
+    return new, x + np.random.default_rng(100 + seed).normal(0.0, 0.02 * impacts[0]["F"], x.size)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_without_the_drop_height_the_line_speed_is_read_from_its_rebounds(seed):
+    """A rebound flies 2 r V/g between leaving the plate and landing again, r its speed ratio (measured from the
+    two pulses: impulse, restitution and shape of the same fruit), so each clear first rebound of a new fruit
+    shows the line's impact speed V = g · flight / (2 r) (signals.analysis.LineAnalyzer.line_speed).  With the
+    flights spread ±10 % (spin), the median of six is within 8 % of the speed the fruit fell at.  Analysed
+    without the drop height (indices only), a fruit and a rebound landing 0.05 ms apart are then told to be an
+    overlap as they are with it (rebounds.landed_with_rebound; without the speed no rebound is ever due, and they
+    were one fruit, graded; the pulse carries 1.6 times the lane's impulse, 3.2 sd above it: seed 0, at 2.9 sd, is
+    one fruit with the drop height too).  Until SPEED_MIN_REBOUNDS rebounds agree there is no speed."""
+    from fruitimpact.signals.analysis import SPEED_MIN_REBOUNDS
+
+    _, x = _lane_with_rebounds(seed)
+    analyzer = Analysis(RATE).analyzer()
+    reports, speeds = [], []
+    for found in detect(x, RATE):
+        reports += analyzer.reports(found)
+        speeds.append(analyzer.line_speed())
+    rebounds = [r for r in reports if r["rebound"]]
+    assert len(rebounds) >= 6, [r["message"] for r in reports]
+    assert speeds[2 * SPEED_MIN_REBOUNDS - 2] is None  # one rebound short
+    assert analyzer.line_speed() == pytest.approx(V_LINE, rel=0.08)
+    last = reports[-1]
+    assert last["status"] == "overlap" and "a fruit and a rebound landing together" in last["message"], last
+    assert math.isnan(last["firmness_c"])
+    # with the drop height given, the same: the speed read is the one the analysis is told
+    given = Analysis(RATE, velocity=V_LINE).analyzer()
+    reports = [r for found in detect(x, RATE) for r in given.reports(found)]
+    assert given.line_speed() == V_LINE and reports[-1]["status"] == "overlap"
+
+
+def test_rebounds_that_disagree_on_the_line_speed_give_none():
+    """Flights scattered over 0.55–1.45 times 2 e V/g (no line flies like that): the speeds their rebounds show
+    spread beyond SPEED_SPREAD (median absolute deviation ~30 % of the median), so the line has no speed, and
+    nothing is predicted from one."""
+    from fruitimpact.signals.analysis import SPEED_SPREAD
+
+    _, x = _lane_with_rebounds(1, flights=[0.55, 1.45, 0.8, 1.2, 1.0, 0.65])
+    analyzer = Analysis(RATE).analyzer()
+    for found in detect(x, RATE):
+        analyzer.reports(found)
+    speeds = np.asarray(analyzer._speeds)
+    assert len(speeds) >= 4
+    assert np.median(np.abs(speeds - np.median(speeds))) > SPEED_SPREAD * np.median(speeds)
+    assert analyzer.line_speed() is None
+
+
+def test_a_contact_a_hidden_fruits_rebound_explains_only_a_little_better_than_a_new_fruit_is_a_new_fruit():
+    """Between a hidden fruit's rebound (the lane's fruit at r V) and a new fruit (at V) lies a contact of the
+    lane's fruit landing at an intermediate speed: where the rebound's distance is below the new fruit's but by
+    less than STRONG_EVIDENCE in squared sd (2 ln B < 6: odds under 20 : 1, Kass & Raftery 1995), the evidence
+    does not decide; it is a new fruit, said to be ambiguous, with both distances (seen on a lane of apples and
+    pears: a fruit taken for a rebound at 2 ln B = 2.0).  The lane is as wide as such a lane: masses 0.6–1.4,
+    stiffness 0.6–1.6 times the lot's, e 0.45–0.7 (a narrow lane leaves no such contact: its new fruit lie far)."""
+    from fruitimpact.signals.rebounds import judge_unmeasured
+    from fruitimpact.signals.rebounds.lane import STRONG_EVIDENCE
+
+    rng = np.random.default_rng(11)
+    fruit = [summary(impact(mass=MASS * rng.uniform(0.6, 1.4), stiffness=STIFFNESS * rng.uniform(0.6, 1.6),
+                            restitution=rng.uniform(0.45, 0.7)), 0.1 * k, k, velocity=V_LINE) for k in range(8)]
+    hidden = impact(restitution=0.57)
+    left = 1.0 + hidden["T"]
+    flight = 2 * hidden["e"] * V_LINE / G
+    close = []
+    for u in np.linspace(hidden["e"], 1.0, 200):
+        candidate = summary(impact(velocity=u * V_LINE, c=hidden["c"]), left + flight, 99)
+        verdict = judge_unmeasured(candidate, 42, 1.0, fruit, V_LINE)
+        ev = verdict.evidence
+        if ev and ev["score"] is not None and ev["score"] <= 1.0 and ev["rebound_distance"] is not None:
+            margin = ev["new_fruit_distance"] ** 2 - ev["rebound_distance"] ** 2
+            if 0 < margin < STRONG_EVIDENCE:
+                close.append((margin, verdict))
+    assert close, "no contact between the two hypotheses within the margin"
+    for margin, verdict in close:
+        assert not verdict.rebound and verdict.ambiguous, (margin, verdict.evidence)
+        assert "about as well or better" in verdict.evidence["reason"]

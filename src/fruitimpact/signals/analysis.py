@@ -84,6 +84,14 @@ FITS_AGAIN = 2
 LANE_FRUIT_KEPT = 15
 #: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
 DEFAULT_MAX_FLIGHT = 0.3
+#: The line's impact speed read from its own rebounds when it is not given (``LineAnalyzer.line_speed``): each
+#: clear first rebound of a new fruit flew 2 r V/g (r its speed ratio, measured from the two pulses), so
+#: V = g · flight / (2 r).  It is used once ``SPEED_MIN_REBOUNDS`` agree: their median, from the last
+#: ``SPEED_KEPT``, when its median absolute deviation is within ``SPEED_SPREAD`` of it (spin and an off-axis
+#: bounce move one flight by ±10–20 %; a lot whose rebounds disagree more gives no speed).
+SPEED_MIN_REBOUNDS = 4
+SPEED_KEPT = 15
+SPEED_SPREAD = 0.15
 
 
 @dataclass(frozen=True)
@@ -166,6 +174,8 @@ class LineAnalyzer:
         self._fruit: dict[int, list[PulseSummary]] = {}
         #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
+        #: the line's impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
+        self._speeds: list[float] = []
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
@@ -387,7 +397,7 @@ class LineAnalyzer:
             status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
             _without_firmness(report)
-        speed = analysis.velocity
+        speed = self.line_speed()
         if orphan is not None:
             speed = None  # its speed is not measured: the fit leaves m and K unsplit
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
@@ -397,6 +407,7 @@ class LineAnalyzer:
             index = claimed_parent(summary, history, chosen.parent)
             parent = history[index]
             history[index] = parent.taken()
+            self._read_speed(impact.lane, summary, parent, chosen)
             # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
             speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
                 else None
@@ -458,6 +469,32 @@ class LineAnalyzer:
         return report
 
 
+    def line_speed(self) -> float | None:
+        """The line's impact speed [m/s]: the analysis's own (``velocity``, from the drop height), else the one its
+        rebounds show (``SPEED_MIN_REBOUNDS`` clear first rebounds of new fruit, on any lane, agreeing within
+        ``SPEED_SPREAD``), else None; None too when the mass is given (then each fit finds its fruit's speed)."""
+        analysis = self.analysis
+        if analysis.velocity is not None or (analysis.fit and analysis.mass is not None):
+            return analysis.velocity
+        if len(self._speeds) < SPEED_MIN_REBOUNDS:
+            return None
+        speeds = np.asarray(self._speeds)
+        median = float(np.median(speeds))
+        spread = float(np.median(np.abs(speeds - median)))
+        return median if spread <= SPEED_SPREAD * median else None
+
+    def _read_speed(self, lane: int, rebound: PulseSummary, parent: PulseSummary, verdict: Verdict) -> None:
+        """Keep the impact speed that ``rebound``'s flight shows, V = g · flight / (2 r), when it is a clear first
+        rebound (not ambiguous) of a measured new fruit of ``lane`` (``line_speed``)."""
+        if self.analysis.velocity is not None or verdict.ambiguous or parent.virtual or not verdict.speed_ratio:
+            return
+        if not any(fruit.sequence == parent.sequence for fruit in self._fruit.get(lane, [])):
+            return  # a rebound's own bounce: its parent's speed is a guess
+        flight = rebound.onset - parent.separation
+        if flight > 0 and verdict.speed_ratio > 0:
+            self._speeds.append(STANDARD_GRAVITY * flight / (2.0 * verdict.speed_ratio))
+            del self._speeds[:-SPEED_KEPT]
+
     def _lane_fruit(self, lane: int) -> list[PulseSummary]:
         """The measured new fruit that stand for the next fruit of ``lane``: its own, or, until it has
         ``LANE_FRUIT_MIN``, those of every lane (one lot on one line, landing at the one speed the analysis is
@@ -471,7 +508,7 @@ class LineAnalyzer:
         """The fruit hidden in the lane's recent overlaps whose rebound is due during ``summary``'s contact
         (``rebounds.unmeasured_fruit``: each the lane's typical fruit at the line's speed, landing at the overlap's
         onset); none without the line's speed or ``LANE_FRUIT_MIN`` measured fruit."""
-        velocity = self.analysis.velocity
+        velocity = self.line_speed()
         fruit = self._lane_fruit(lane)
         if velocity is None or len(fruit) < LANE_FRUIT_MIN:
             return []
@@ -487,7 +524,7 @@ class LineAnalyzer:
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
         fruit = self._lane_fruit(lane)
-        verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.analysis.velocity)
+        verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.line_speed())
                     for sequence, onset, _ in reversed(recent)]
         return min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
                    else math.inf, default=NEW_FRUIT)
