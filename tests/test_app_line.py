@@ -73,8 +73,10 @@ def _cli_line_error(tmp_path, csv_text: str, *argv) -> str:
 def _csv(rows: list[dict]) -> str:
     """A line CSV with the rows' cells as they are, any of them bad (the page's line.csv is only written for a
     line it accepts)."""
-    lines = ["name,drop_height,surface,fruit_on_fruit"]
-    lines += [f"{r['name']},{r['drop_height']},{r['surface']},{str(r['fruit_on_fruit']).lower()}" for r in rows]
+    measured = any(column in r for r in rows for column in ("surface_modulus", "surface_poisson"))
+    lines = ["name,drop_height,surface,fruit_on_fruit" + (",surface_modulus,surface_poisson" if measured else "")]
+    lines += [f"{r['name']},{r['drop_height']},{r['surface']},{str(r['fruit_on_fruit']).lower()}"
+              + (f",{r.get('surface_modulus', '')},{r.get('surface_poisson', '')}" if measured else "") for r in rows]
     return "\n".join(lines) + "\n"
 
 
@@ -121,14 +123,38 @@ def test_the_command_and_line_csv_reproduce_the_audit(server, tmp_path):
 
 
 @pytest.mark.parametrize("column, bad", [("drop_height", "3 parsecs"), ("drop_height", "-3cm"), ("drop_height", "30m"),
-                                         ("surface", "lava"), ("name", ""), ("fruit_on_fruit", "maybe")])
+                                         ("surface", "lava"), ("name", ""), ("fruit_on_fruit", "maybe"),
+                                         ("surface_modulus", "soft"), ("surface_modulus", "-2MPa"),
+                                         ("surface_poisson", "0.7")])
 def test_a_refused_cell_gets_the_clis_line_and_names_the_cell(server, tmp_path, column, bad):
     rows = [dict(row) for row in page.DEFAULT_POINTS]
+    if column.startswith("surface_"):  # a measured surface: both cells, one of them bad
+        rows[1].update(surface_modulus="20MPa", surface_poisson="0.3")
     rows[1][column] = bad
     status, body = _post(server + "api/line", {"points": rows})
     assert status == 200 and body["refused"] is True
     assert body["argument"] == ["points", 1, column]
     assert body["error"] == _cli_line_error(tmp_path, _csv(rows), "--fruit", "apple")
+
+
+def test_a_measured_surface_reads_as_the_line_csv_reads_it(server, tmp_path):
+    """A row with surface_modulus and surface_poisson (an instrumented sphere's reading) is the point the line CSV
+    gives: the page's line.csv carries both columns, the command reproduces the audit, and the point's report
+    names the measured half-space.  A modulus without its Poisson's ratio is refused at the missing cell."""
+    rows = [dict(row) for row in page.DEFAULT_POINTS]
+    rows[1].update(surface_modulus="20MPa", surface_poisson="0.3")
+    body = _post(server + "api/line", {"points": rows, "rows": "200", "seed": "3", "failure_stress": "0.3MPa"})[1]
+    assert "surface_modulus,surface_poisson" in body["line_csv"].splitlines()[0]
+    point = body["report"]["points"][1]
+    assert point["surface_modulus"] == 20e6 and point["surface_poisson"] == 0.3
+    (tmp_path / body["file"]).write_text(body["line_csv"])
+    done = _cli(*shlex.split(body["command"])[1:], "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout) == body["report"]
+    del rows[1]["surface_poisson"]
+    refused = _post(server + "api/line", {"points": rows})[1]
+    assert refused["argument"] == ["points", 1, "surface_poisson"]
+    assert refused["error"] == _cli_line_error(tmp_path, _csv(rows), "--fruit", "apple")
 
 
 def test_a_name_given_twice_is_refused_at_its_second_row(server, tmp_path):

@@ -221,6 +221,28 @@ def test_line_incidence_is_the_batch_bruise_rate_of_the_same_members(tmp_path):
     assert report["worst_point"] == worst["name"]
 
 
+def test_a_measured_surface_in_a_line_file_is_that_half_space(tmp_path):
+    """surface_modulus and surface_poisson make a point's surface a measured half-space (an instrumented sphere's
+    reading).  Given wood's own library values (0.7 GPa, ν 0.35) they are wood: the same incidence, bruise volume
+    and peak force to the last digit for the same lot.  A softer half-space (20 MPa) is hit more gently: Hertz's
+    E* = (1/E*_fruit + (1 − ν²)/E_surface)⁻¹ falls, so does the peak force (F ∝ E*^(2/5)), and the incidence
+    with it.  Blank cells are the library surface's own values; the report names the half-space it used."""
+    path = tmp_path / "line.csv"
+    path.write_text("name,drop_height,surface,fruit_on_fruit,surface_modulus,surface_poisson\n"
+                    "library,4cm,wood,false,,\nmeasured,4cm,wood,false,0.7GPa,0.35\nsoft,4cm,wood,false,20MPa,0.35\n")
+    points = read_line(path)
+    assert points[0].surface_modulus is None and points[1].surface_modulus == 0.7e9
+    rng = np.random.default_rng(5)
+    rows = 2000
+    members = {"mass": rng.normal(0.17, 0.02, rows), "modulus": rng.lognormal(np.log(3e6), 0.2, rows),
+               "failure_stress": np.full(rows, 3e5), "bruise_susceptibility": np.full(rows, 4e-6)}
+    library, measured, soft = audit(points, members, rows, "shear", {}, alternatives=())["points"]
+    for key in ("incidence", "mean_bruise_volume", "mean_peak_force"):
+        assert measured[key] == library[key], key
+    assert (library["surface_modulus"], measured["surface_modulus"], measured["surface_poisson"]) == (None, 0.7e9, 0.35)
+    assert soft["mean_peak_force"] < 0.97 * library["mean_peak_force"] and soft["incidence"] < library["incidence"]
+
+
 @pytest.mark.parametrize("text, message", [
     ("name,drop_height,surface\na,10cm,granite\n", "surface must be one of"),
     ("name,drop_height,surface\na,-10cm,steel\n", "drop_height must be in (0, 10] m"),
@@ -229,6 +251,13 @@ def test_line_incidence_is_the_batch_bruise_rate_of_the_same_members(tmp_path):
     ("name,drop_height\na,10cm\n", "missing column(s) surface"),
     ("name,drop_height,surface,fruit_on_fruit\na,10cm,steel,maybe\n", "fruit_on_fruit must be true or false"),
     ("name,drop_height,surface\na,nan,steel\n", "drop_height must be in (0, 10] m"),
+    ("name,drop_height,surface,surface_modulus\na,10cm,wood,20MPa\n",
+     "surface_poisson must be given with surface_modulus"),
+    ("name,drop_height,surface,surface_modulus,surface_poisson\na,10cm,wood,soft,0.3\n", "surface_modulus: cannot read"),
+    ("name,drop_height,surface,surface_modulus,surface_poisson\na,10cm,wood,0Pa,0.3\n",
+     "surface_modulus must be > 0 Pa"),
+    ("name,drop_height,surface,surface_modulus,surface_poisson\na,10cm,wood,20MPa,0.5\n",
+     "surface_poisson must be in (-1, 0.5)"),
 ])
 def test_bad_lines_are_refused_with_their_line_number(tmp_path, text, message):
     path = tmp_path / "line.csv"

@@ -23,8 +23,9 @@ import math
 import shlex
 
 from fruitimpact.app.inputs import typed_value
-from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_LINE_FRUIT, MAX_POINTS, TransferPoint,
-                                       _checked_point, _distinct)
+from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_LINE_FRUIT, MAX_POINTS,
+                                      MEASURED_SURFACE_COLUMNS, TransferPoint, measured_surface,
+                                      _checked_point, _distinct)
 from fruitimpact.impact.outputs import json_safe
 from fruitimpact.impact.quantities import option_of
 from fruitimpact.impact.validation import InputError, read_count, usage_message
@@ -130,13 +131,19 @@ def read_points(points) -> tuple[list[TransferPoint], list[dict]]:
             height = parse_quantity(cells["drop_height"], "length")
         except ValueError as error:
             raise refused(f"{where}: drop_height: {error}", "drop_height") from None
+        measured = {}
+        for column in MEASURED_SURFACE_COLUMNS:
+            measured[column] = _cell_text(row.get(column, ""))
+            if measured[column] is None:
+                raise refused(f"{where}: {column} must be a number or a text; got {row[column]!r}", column)
         try:
-            point = _checked_point(TransferPoint(cells["name"], height, cells["surface"], flag), where)
-        except ValueError as error:  # "<where>: <column> must be …": the cell is the column it names
-            column = str(error)[len(where) + 2:].split(" ", 1)[0]
+            point = _checked_point(TransferPoint(cells["name"], height, cells["surface"], flag,
+                                                 *measured_surface(measured, where)), where)
+        except ValueError as error:  # "<where>: <column> must be …" or "<where>: <column>: …": that column's cell
+            column = str(error)[len(where) + 2:].split(" ", 1)[0].rstrip(":")
             raise refused(str(error), column if column in LINE_COLUMNS else "name") from None
         read.append(point)
-        rows.append({**cells, "fruit_on_fruit": flag})
+        rows.append({**cells, "fruit_on_fruit": flag, **{k: v for k, v in measured.items() if v}})
     try:
         _distinct(read, LINE_FILE)
     except ValueError as error:
@@ -156,9 +163,15 @@ def _csv_field(text: str) -> str:
 
 def line_csv(rows: list[dict]) -> str:
     """The line CSV of the table's rows, as ``read_line`` reads it back (the page's ``line.csv``)."""
-    lines = [",".join(LINE_COLUMNS)]
-    lines += [",".join([_csv_field(row["name"]), _csv_field(row["drop_height"]), _csv_field(row["surface"]),
-                        "true" if row["fruit_on_fruit"] else "false"]) for row in rows]
+    measured = any(row.get(column) for row in rows for column in MEASURED_SURFACE_COLUMNS)
+    columns = [column for column in LINE_COLUMNS if measured or column not in MEASURED_SURFACE_COLUMNS]
+    lines = [",".join(columns)]
+    for row in rows:
+        fields = [_csv_field(row["name"]), _csv_field(row["drop_height"]), _csv_field(row["surface"]),
+                  "true" if row["fruit_on_fruit"] else "false"]
+        if measured:
+            fields += [_csv_field(row.get(column, "")) for column in MEASURED_SURFACE_COLUMNS]
+        lines.append(",".join(fields))
     return "\n".join(lines) + "\n"
 
 

@@ -180,7 +180,8 @@ def cmd_line(args) -> int:
         print(f"{'transfer point':<22}{'h [cm]':>8}{'surface':>13}{'incidence':>11}{'BV [mm³]':>10}"
               f"{'cum. inc.':>11}{'cum. BV':>10}{'F_max [N]':>11}")
         for point in report["points"]:
-            surface = "fruit" if point["fruit_on_fruit"] else point["surface"]
+            surface = "fruit" if point["fruit_on_fruit"] else point["surface"] \
+                if point.get("surface_modulus") is None else f"{point['surface_modulus'] / 1e6:.3g} MPa"
             print(f"{point['name'][:21]:<22}{point['drop_height'] * 100:>8.4g}{surface:>13}"
                   f"{point['incidence'] * 100:>10.3g}%{point['mean_bruise_volume'] * 1e9:>10.4g}"
                   f"{point['cumulative_incidence'] * 100:>10.3g}%{point['cumulative_bruise_volume'] * 1e9:>10.4g}"
@@ -298,7 +299,9 @@ def add_parsers(sub) -> None:
 
     ln = sub.add_parser("line", help="packing-line audit: bruise incidence at each transfer point",
                         description="Pass a population of fruit through the transfer points of LINE "
-                                    "(CSV: name,drop_height,surface[,fruit_on_fruit]).")
+                                    "(CSV: name,drop_height,surface[,fruit_on_fruit]"
+                                    "[,surface_modulus,surface_poisson]: the last two, given together, a measured "
+                                    "half-space, e.g. from `sphere`).")
     ln.add_argument("line", metavar="LINE", help="the line's transfer points, CSV")
     add_lot_options(ln)
     ln.add_argument("--alternatives", default="foam-pad", metavar="SURFACES",

@@ -24,7 +24,9 @@ import numpy as np
 from fruitimpact.library.textfiles import table_lines, yes_or_no
 
 #: Columns of a line table; ``fruit_on_fruit`` is optional.
-LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit")
+LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit", "surface_modulus", "surface_poisson")
+#: The optional columns of a measured surface (both or neither in a row; blank: the library surface's own).
+MEASURED_SURFACE_COLUMNS = ("surface_modulus", "surface_poisson")
 #: Transfer points of a line at most.
 MAX_POINTS = 200
 
@@ -65,10 +67,36 @@ def _points(line) -> list[TransferPoint]:
         raise InputError(str(exc), "line") from None
 
 
+def measured_surface(cells: dict, where: str) -> tuple[float | None, float | None]:
+    """(surface_modulus [Pa], surface_poisson [-]) of a row's cells (texts; units accepted: ``"2.5MPa"``), or
+    (None, None) when the row gives neither (blank or absent): then the library surface's own values hold.
+    ``ValueError`` naming ``where`` and the column otherwise (one without the other, not a number); the ranges are
+    ``_checked_point``'s."""
+    from fruitimpact.impact.units import parse_quantity
+
+    texts = {column: str(cells.get(column, "") or "").strip() for column in MEASURED_SURFACE_COLUMNS}
+    if not any(texts.values()):
+        return None, None
+    for column, other in (MEASURED_SURFACE_COLUMNS, MEASURED_SURFACE_COLUMNS[::-1]):
+        if not texts[column]:
+            raise ValueError(f"{where}: {column} must be given with {other} (a measured half-space needs both; "
+                             f"leave both blank for the library surface's own)")
+    values = []
+    for column, dimension in zip(MEASURED_SURFACE_COLUMNS, ("modulus", "dimensionless")):
+        try:
+            values.append(parse_quantity(texts[column], dimension))
+        except ValueError as exc:
+            raise ValueError(f"{where}: {column}: {exc}") from None
+    return values[0], values[1]
+
+
 def read_line(path) -> list[TransferPoint]:
-    """The transfer points of a line CSV (header ``name,drop_height,surface[,fruit_on_fruit]``;
-    ``#`` comment lines allowed).  ``ValueError`` naming the line and the column of the first problem:
-    unknown or missing columns, ragged rows, unknown surfaces, heights that are not positive."""
+    """The transfer points of a line CSV (header ``name,drop_height,surface[,fruit_on_fruit]
+    [,surface_modulus,surface_poisson]``; ``#`` comment lines allowed).  ``surface_modulus`` [Pa, units accepted]
+    and ``surface_poisson`` [-], given together, make the point's surface a measured half-space (e.g. an
+    instrumented sphere's reading, ``fruitimpact sphere``), ``surface`` then naming it in the report.
+    ``ValueError`` naming the line and the column of the first problem: unknown or missing columns, ragged rows,
+    unknown surfaces, heights that are not positive, a modulus without its Poisson's ratio."""
     import csv
     import os
 
@@ -104,7 +132,9 @@ def read_line(path) -> list[TransferPoint]:
         flag = yes_or_no(cells.get("fruit_on_fruit", ""), blank=False)
         if flag is None:
             raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
-        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag), where))
+        modulus, poisson = measured_surface(cells, where)
+        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag, modulus, poisson),
+                                     where))
     return _distinct(points, str(path))
 
 
@@ -137,10 +167,11 @@ def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
     if (point.surface_modulus is None) != (point.surface_poisson is None):
         raise ValueError(f"{where}: a measured surface needs both surface_modulus and surface_poisson")
     if point.surface_modulus is not None and not (
-            isinstance(point.surface_modulus, float) and point.surface_modulus > 0.0
-            and isinstance(point.surface_poisson, float) and -1.0 < point.surface_poisson < 0.5):
-        raise ValueError(f"{where}: surface_modulus must be > 0 Pa and surface_poisson in (-1, 0.5); got "
-                         f"{point.surface_modulus!r}, {point.surface_poisson!r}")
+            isinstance(point.surface_modulus, float) and 0.0 < point.surface_modulus < math.inf):
+        raise ValueError(f"{where}: surface_modulus must be > 0 Pa and finite; got {point.surface_modulus!r}")
+    if point.surface_poisson is not None and not (
+            isinstance(point.surface_poisson, float) and -1.0 < point.surface_poisson < 0.5):
+        raise ValueError(f"{where}: surface_poisson must be in (-1, 0.5); got {point.surface_poisson!r}")
     return point
 
 
@@ -170,7 +201,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
 
     ``constants``: inputs shared by all (criterion inputs, model …).  Returns a dict with
     ``points`` (one dict per transfer point: ``name``, ``drop_height``, ``surface``,
-    ``fruit_on_fruit``, ``velocity``, ``incidence``, ``mean_bruise_volume``, ``mean_peak_force``,
+    ``fruit_on_fruit``, ``surface_modulus`` and ``surface_poisson`` (a measured half-space, None for the library
+    surface's own values), ``velocity``, ``incidence``, ``mean_bruise_volume``, ``mean_peak_force``,
     ``mean_max_pressure``, ``cumulative_incidence``, ``cumulative_bruise_volume``, ``invalid``,
     ``failed``), ``worst_point``, ``incidence`` (on the whole line), ``mean_bruise_volume``,
     ``criterion`` and ``warnings``.  A point's figures are over the fruit computed there; the
@@ -243,6 +275,8 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
         report.append({
             "name": point.name, "drop_height": point.drop_height, "surface": point.surface,
             "fruit_on_fruit": point.fruit_on_fruit,
+            # a measured half-space in place of the library surface's values (None: the library's own)
+            "surface_modulus": point.surface_modulus, "surface_poisson": point.surface_poisson,
             "velocity": math.sqrt(2.0 * STANDARD_GRAVITY * point.drop_height),
             "incidence": _share(bruised[ok].sum(), count),
             "mean_bruise_volume": _share(volume[ok].sum(), count),
@@ -310,8 +344,8 @@ def _or_zero(value: float) -> float:
     return 0.0 if math.isnan(value) else value
 
 
-__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS", "Pad", "TransferPoint",
-           "audit", "audit_line", "read_line"]
+__all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS",
+           "MEASURED_SURFACE_COLUMNS", "Pad", "TransferPoint", "audit", "audit_line", "measured_surface", "read_line"]
 
 
 #: Highest drop a transfer point may have [m] (the safe-height search's own ceiling, ``heights.HIGHEST``).
@@ -335,7 +369,8 @@ def audit_line(line, *, rows: int = LINE_FRUIT, seed: int = 0, criterion: str | 
     Parameters
     ----------
     line : str, path or list of TransferPoint
-        A line CSV (``name,drop_height,surface[,fruit_on_fruit]``, see :func:`read_line`) or its points.
+        A line CSV (``name,drop_height,surface[,fruit_on_fruit][,surface_modulus,surface_poisson]``, see
+        :func:`read_line`) or its points.
     rows : int
         Fruit in the lot, 1 to 10,000,000 (default 10,000; ``"1e5"`` accepted).
     seed : int
