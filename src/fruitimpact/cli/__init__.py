@@ -40,6 +40,26 @@ def _command(argv) -> str | None:
     return next((token for token in argv if token in COMMANDS), None)
 
 
+#: Set by the console script's SIGINT handler (``_note_interrupts``): a Ctrl-C arrived.
+_SIGNALLED: list = []
+
+
+def _note_interrupts() -> None:
+    """Python's own answer to SIGINT (KeyboardInterrupt at the next bytecode), noted as it is raised.  A Ctrl-C
+    that lands inside an import run by C code can come back as another error: NumPy's C extension imports
+    ``datetime`` through ``PyCapsule_Import``, which replaces the KeyboardInterrupt by "ImportError:
+    PyCapsule_Import could not import module "datetime"" (seen once in 24 SIGINTs 0.55–0.9 s into a start-up
+    under load).  With the note, ``main`` answers such a failure as the interrupt it is."""
+    import signal
+
+    def interrupt(signum, frame):
+        _SIGNALLED.append(signum)
+        raise KeyboardInterrupt
+
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not when SIGINT is ignored (nohup, &)
+        signal.signal(signal.SIGINT, interrupt)
+
+
 #: Callbacks in which a Ctrl-C was swallowed.  numba's compiler then fails on its own (a cache that never
 #: received its object: "RuntimeError: no compiled object yet"), before the interrupt is delivered again;
 #: that failure is the interrupt's, and is answered as one.
@@ -144,6 +164,7 @@ def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         if console:
+            _note_interrupts()
             _defer_numpy()  # before the first module that names NumPy
         from fruitimpact.cli.common import UsageError, _attach_negative_values, _numba_without_blas
 
@@ -184,11 +205,11 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # e.g. piped into head
         return 0
     except Exception:
-        if not _SWALLOWED:
+        if not _SWALLOWED and not _SIGNALLED:
             raise
         if console:
             _answering()
-        command = _command(argv)  # a failure caused by a Ctrl-C swallowed in a C callback
+        command = _command(argv)  # a failure caused by a Ctrl-C (swallowed in a C callback, or replaced in C code)
         print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
         return 130
     finally:
