@@ -355,9 +355,9 @@ def _covers(report: dict, contact: dict) -> bool:
 
 
 def _plate_ends(contacts: list[dict]) -> dict[int, float]:
-    """For each truth contact (by ``id``), when its lane's plate returns to baseline after it [s]: its own end,
-    or, when later contacts land while it is still on the plate, the end of the last of that touching chain
-    (contact intervals merged per lane)."""
+    """For each truth contact (by its ``index``), when its lane's plate returns to baseline after it [s]: its own
+    end, or, when later contacts land while it is still on the plate, the end of the last of that touching chain
+    (contact intervals merged per lane; one starting exactly as the chain ends starts a chain of its own)."""
     ends: dict[int, float] = {}
     by_lane: dict = {}
     for c in contacts:
@@ -369,7 +369,7 @@ def _plate_ends(contacts: list[dict]) -> dict[int, float]:
         for c in lane + [None]:
             if c is None or c["start_time"] >= group_end:
                 for member in group:
-                    ends[id(member)] = group_end
+                    ends[member["index"]] = group_end
                 if c is None:
                     break
                 group, group_end = [], -math.inf
@@ -406,7 +406,7 @@ def evaluate(rec: Recording, run: dict) -> dict:
         block = max(block_of(c) for c in stands_for)
         t_fed = written[block]
         latencies.append(1e3 * (report["_arrival"] - t_fed))
-        plate_block = max(block_of({"end_time": plate_end[id(c)]}) for c in stands_for)
+        plate_block = max(block_of({"end_time": plate_end[c["index"]]}) for c in stands_for)
         plate.append(1e3 * (report["_arrival"] - written[plate_block]))
         scheduled.append(1e3 * (report["_arrival"] - deadlines[block]))
         fed.append(t_fed)
@@ -463,7 +463,8 @@ def meets_goal(row: dict) -> bool:
 # ---------------------------------------------------------------------------------------------------------------
 
 HEADERS = ["lanes", "input", "analysis", "contacts", "reported", "missed fruit", "missed reb.", "overlap-covered",
-           "extra", "p50 [ms]", "p99 [ms]", "max [ms]", "touching", "p99 plate [ms]", "max plate [ms]", "1st [ms]", "p99 after start-up [ms]", "p99 vs schedule [ms]",
+           "extra", "p50 [ms]", "p99 [ms]", "max [ms]", "touching", "p99 plate [ms]", "max plate [ms]",
+           "1st [ms]", "p99 after start-up [ms]", "p99 vs schedule [ms]",
            "after EOF",
            "bunched", "feed late p99/max [ms]", "stream CPU", "load", "goal"]
 

@@ -151,6 +151,11 @@ def test_a_measured_surface_reads_as_the_line_csv_reads_it(server, tmp_path):
     done = _cli(*shlex.split(body["command"])[1:], "--json", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout) == body["report"]
+    # the report's points sent back: null is a blank cell (the library surface's own values)
+    back = [{key: point[key] for key in ("name", "drop_height", "surface", "fruit_on_fruit", "surface_modulus",
+                                         "surface_poisson")} for point in body["report"]["points"]]
+    again = _post(server + "api/line", {"points": back, "rows": "200", "seed": "3", "failure_stress": "0.3MPa"})[1]
+    assert again["report"]["points"] == body["report"]["points"]
     del rows[1]["surface_poisson"]
     refused = _post(server + "api/line", {"points": rows})[1]
     assert refused["argument"] == ["points", 1, "surface_poisson"]

@@ -258,6 +258,11 @@ def test_a_measured_surface_in_a_line_file_is_that_half_space(tmp_path):
      "surface_modulus must be > 0 Pa"),
     ("name,drop_height,surface,surface_modulus,surface_poisson\na,10cm,wood,20MPa,0.5\n",
      "surface_poisson must be in (-1, 0.5)"),
+    ("name,drop_height,surface,fruit_on_fruit,surface_modulus,surface_poisson\na,10cm,steel,true,20MPa,0.3\n",
+     "but fruit_on_fruit lands the fruit on another fruit"),
+    ("name,drop_height,surface,surface_modulus,surface_poisson,surface_modulus\na,10cm,steel,20MPa,0.3,5MPa\n",
+     "column 'surface_modulus' is given twice"),
+    ("name,drop_height,surface\n# a comment\n\na,-10cm,steel\n", "line 4: drop_height"),  # the file's own line
 ])
 def test_bad_lines_are_refused_with_their_line_number(tmp_path, text, message):
     path = tmp_path / "line.csv"

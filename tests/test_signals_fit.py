@@ -79,7 +79,7 @@ def test_the_shape_table_matches_the_exact_engine():
     X_MAX, e ≈ 0.1, a truncated Chebyshev series converges slowest where the pulse is least smooth) and five
     orders below it for x ≤ 4 (e ≥ 0.24, every fruit on a plate)."""
     assert shape_table_error(samples=100) < 1e-5
-    assert shape_table_error(samples=100, seed=2, x_max=4.0) < 1e-7
+    assert shape_table_error(samples=100, seed=2, x_max=4.0) < 2e-7  # 9.8e-8 the largest of 12,000 samples
 
 
 def test_noise_free_pulse_is_recovered_to_the_table_accuracy():

@@ -132,8 +132,8 @@ def read_points(points) -> tuple[list[TransferPoint], list[dict]]:
         except ValueError as error:
             raise refused(f"{where}: drop_height: {error}", "drop_height") from None
         measured = {}
-        for column in MEASURED_SURFACE_COLUMNS:
-            measured[column] = _cell_text(row.get(column, ""))
+        for column in MEASURED_SURFACE_COLUMNS:  # optional: absent, null (as the report writes it) or "" is blank
+            measured[column] = _cell_text("" if row.get(column) is None else row[column])
             if measured[column] is None:
                 raise refused(f"{where}: {column} must be a number or a text; got {row[column]!r}", column)
         try:

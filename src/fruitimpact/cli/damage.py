@@ -152,6 +152,16 @@ def cmd_safe_height(args) -> int:
 
 
 # ------------------------------------------------------------------------------------------------ line
+def _surface_label(point: dict) -> str:
+    """What a line report's point was dropped onto, for the table: ``fruit``, the library surface, or the measured
+    half-space's modulus (``surface_modulus``, in place of the library surface's values)."""
+    if point["fruit_on_fruit"]:
+        return "fruit"
+    if point.get("surface_modulus") is None:
+        return point["surface"]
+    return f"{point['surface_modulus'] / 1e6:.3g} MPa"
+
+
 def cmd_line(args) -> int:
     from fruitimpact.handling.line import audit_line, read_line
 
@@ -180,15 +190,17 @@ def cmd_line(args) -> int:
         print(f"{'transfer point':<22}{'h [cm]':>8}{'surface':>13}{'incidence':>11}{'BV [mm³]':>10}"
               f"{'cum. inc.':>11}{'cum. BV':>10}{'F_max [N]':>11}")
         for point in report["points"]:
-            surface = "fruit" if point["fruit_on_fruit"] else point["surface"] \
-                if point.get("surface_modulus") is None else f"{point['surface_modulus'] / 1e6:.3g} MPa"
+            surface = _surface_label(point)
             print(f"{point['name'][:21]:<22}{point['drop_height'] * 100:>8.4g}{surface:>13}"
                   f"{point['incidence'] * 100:>10.3g}%{point['mean_bruise_volume'] * 1e9:>10.4g}"
                   f"{point['cumulative_incidence'] * 100:>10.3g}%{point['cumulative_bruise_volume'] * 1e9:>10.4g}"
                   f"{point['mean_peak_force']:>11.4g}")
         print(f"most harmful transfer point: {report['worst_point']}")
+        measured = {point["name"]: _surface_label(point) for point in report["points"]
+                    if point.get("surface_modulus") is not None}
         for change in report["changes"][:5]:
-            print(f"  {change['to']} in place of {change['from']} at {change['point']}: line incidence "
+            replaced = measured.get(change["point"], change["from"])
+            print(f"  {change['to']} in place of {replaced} at {change['point']}: line incidence "
                   f"{change['incidence'] * 100:.3g} % (saves {change['incidence_saved'] * 100:.3g} points), mean "
                   f"bruise volume {change['mean_bruise_volume'] * 1e9:.4g} mm³ (saves "
                   f"{change['bruise_volume_saved'] * 1e9:.4g})")

@@ -24,9 +24,10 @@ import numpy as np
 from fruitimpact.library.textfiles import table_lines, yes_or_no
 
 #: Columns of a line table; ``fruit_on_fruit`` is optional.
-LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit", "surface_modulus", "surface_poisson")
 #: The optional columns of a measured surface (both or neither in a row; blank: the library surface's own).
 MEASURED_SURFACE_COLUMNS = ("surface_modulus", "surface_poisson")
+#: The columns of a line CSV: the first three required, the rest optional.
+LINE_COLUMNS = ("name", "drop_height", "surface", "fruit_on_fruit", *MEASURED_SURFACE_COLUMNS)
 #: Transfer points of a line at most.
 MAX_POINTS = 200
 
@@ -77,10 +78,12 @@ def measured_surface(cells: dict, where: str) -> tuple[float | None, float | Non
     texts = {column: str(cells.get(column, "") or "").strip() for column in MEASURED_SURFACE_COLUMNS}
     if not any(texts.values()):
         return None, None
-    for column, other in (MEASURED_SURFACE_COLUMNS, MEASURED_SURFACE_COLUMNS[::-1]):
-        if not texts[column]:
-            raise ValueError(f"{where}: {column} must be given with {other} (a measured half-space needs both; "
-                             f"leave both blank for the library surface's own)")
+    missing = next(column for column in MEASURED_SURFACE_COLUMNS if not texts[column]) \
+        if not all(texts.values()) else None
+    if missing is not None:
+        given = next(column for column in MEASURED_SURFACE_COLUMNS if column != missing)
+        raise ValueError(f"{where}: {missing} must be given with {given} (a measured half-space needs both; "
+                         f"leave both blank for the library surface's own)")
     values = []
     for column, dimension in zip(MEASURED_SURFACE_COLUMNS, ("modulus", "dimensionless")):
         try:
@@ -104,14 +107,23 @@ def read_line(path) -> list[TransferPoint]:
 
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
         raise ValueError(f"line must be a path to a line CSV; got {path!r}")
-    rows = list(csv.reader(line for _, line in table_lines(path)))
+    lines = list(table_lines(path))
+    reader = csv.reader(text for _, text in lines)
+    rows, numbers = [], []  # each row and the file's line number it starts on (comment lines are counted)
+    for row in reader:
+        rows.append(row)
+        numbers.append(lines[reader.line_num - 1][0])
     if not rows:
-        raise ValueError(f"{path} is empty: expected a header {','.join(LINE_COLUMNS)}")
+        raise ValueError(f"{path} is empty: expected a header {','.join(LINE_COLUMNS[:3])}"
+                         f"[,{','.join(LINE_COLUMNS[3:])}]")
     header = [cell.strip().replace("-", "_") for cell in rows[0]]
     unknown = [cell for cell in header if cell not in LINE_COLUMNS]
     if unknown:
         raise ValueError(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (columns: "
                          f"{', '.join(LINE_COLUMNS)})")
+    twice = [cell for k, cell in enumerate(header) if cell in header[:k]]
+    if twice:
+        raise ValueError(f"{path}: column {twice[0]!r} is given twice; give each column once")
     missing = [name for name in LINE_COLUMNS[:3] if name not in header]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
@@ -120,7 +132,7 @@ def read_line(path) -> list[TransferPoint]:
     if len(rows) - 1 > MAX_POINTS:
         raise ValueError(f"{path}: {len(rows) - 1} transfer points; at most {MAX_POINTS}")
     points = []
-    for number, row in enumerate(rows[1:], start=2):
+    for number, row in zip(numbers[1:], rows[1:]):
         where = f"{path}, line {number}"
         if len(row) != len(header):
             raise ValueError(f"{where}: {len(row)} fields, the header has {len(header)}")
@@ -166,6 +178,9 @@ def _checked_point(point: TransferPoint, where: str) -> TransferPoint:
         raise ValueError(f"{where}: fruit_on_fruit must be True or False; got {point.fruit_on_fruit!r}")
     if (point.surface_modulus is None) != (point.surface_poisson is None):
         raise ValueError(f"{where}: a measured surface needs both surface_modulus and surface_poisson")
+    if point.fruit_on_fruit and point.surface_modulus is not None:
+        raise ValueError(f"{where}: surface_modulus is a measured surface, but fruit_on_fruit lands the fruit on "
+                         f"another fruit: give one or the other")
     if point.surface_modulus is not None and not (
             isinstance(point.surface_modulus, float) and 0.0 < point.surface_modulus < math.inf):
         raise ValueError(f"{where}: surface_modulus must be > 0 Pa and finite; got {point.surface_modulus!r}")

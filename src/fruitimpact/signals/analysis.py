@@ -84,11 +84,12 @@ FITS_AGAIN = 2
 LANE_FRUIT_KEPT = 15
 #: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
 DEFAULT_MAX_FLIGHT = 0.3
-#: The line's impact speed read from its own rebounds when it is not given (``LineAnalyzer.line_speed``): each
+#: A lane's impact speed read from its own rebounds when it is not given (``LineAnalyzer.line_speed``): each
 #: clear first rebound of a new fruit flew 2 r V/g (r its speed ratio, measured from the two pulses), so
-#: V = g · flight / (2 r).  It is used once ``SPEED_MIN_REBOUNDS`` agree: their median, from the last
-#: ``SPEED_KEPT``, when its median absolute deviation is within ``SPEED_SPREAD`` of it (spin and an off-axis
-#: bounce move one flight by ±10–20 %; a lot whose rebounds disagree more gives no speed).
+#: V = g · flight / (2 r).  It is used once ``SPEED_MIN_REBOUNDS`` of the lane's agree: their median, from the
+#: lane's last ``SPEED_KEPT``, when its median absolute deviation is within ``SPEED_SPREAD`` of it (spin and an
+#: off-axis bounce move one flight by ±10–20 %; rebounds that disagree more give no speed).  Per lane: lanes
+#: may drop from different heights.
 SPEED_MIN_REBOUNDS = 4
 SPEED_KEPT = 15
 SPEED_SPREAD = 0.15
@@ -174,8 +175,8 @@ class LineAnalyzer:
         self._fruit: dict[int, list[PulseSummary]] = {}
         #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
-        #: the line's impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
-        self._speeds: list[float] = []
+        #: per lane: the impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
+        self._speeds: dict[int, list[float]] = {}
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
@@ -397,7 +398,8 @@ class LineAnalyzer:
             status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
             _without_firmness(report)
-        speed = self.line_speed()
+        speed = self.line_speed(impact.lane)
+        read = analysis.velocity is None  # a speed read from the lane's rebounds: no flight is tested against it
         if orphan is not None:
             speed = None  # its speed is not measured: the fit leaves m and K unsplit
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
@@ -411,6 +413,7 @@ class LineAnalyzer:
             # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
             speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
                 else None
+            read = parent.speed_read
         report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound else
                       pair["parents"][0] if pair is not None else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None),
@@ -424,9 +427,9 @@ class LineAnalyzer:
                 report["_fit"] = shape  # its curve (at V = 1 m/s, the same pulse) is still the one to draw
                 message = message or result["message"]
             if speed is None and result.get("converged") and _finite(result.get("velocity")):
-                speed = result["velocity"]  # the mass was given: the fit found the speed
+                speed, read = result["velocity"], False  # the mass was given: the fit found the speed
         if summary is not None:
-            history.append(summary.with_velocity(speed))
+            history.append(summary.with_velocity(speed, read))
             # keep the contacts a later one could still be the rebound of
             recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
             history[:] = recent[-8:]
@@ -468,32 +471,38 @@ class LineAnalyzer:
         report["message"] = message
         return report
 
-
-    def line_speed(self) -> float | None:
-        """The line's impact speed [m/s]: the analysis's own (``velocity``, from the drop height), else the one its
-        rebounds show (``SPEED_MIN_REBOUNDS`` clear first rebounds of new fruit, on any lane, agreeing within
-        ``SPEED_SPREAD``), else None; None too when the mass is given (then each fit finds its fruit's speed)."""
+    def _reads_speed(self) -> bool:
+        """Whether the impact speed is read from the rebounds: neither given nor found by each fit (the mass
+        given)."""
         analysis = self.analysis
-        if analysis.velocity is not None or (analysis.fit and analysis.mass is not None):
-            return analysis.velocity
-        if len(self._speeds) < SPEED_MIN_REBOUNDS:
+        return analysis.velocity is None and not (analysis.fit and analysis.mass is not None)
+
+    def line_speed(self, lane: int) -> float | None:
+        """The impact speed [m/s] of ``lane``'s fruit: the analysis's own (``velocity``, from the drop height), else
+        the one the lane's rebounds show (``SPEED_MIN_REBOUNDS`` clear first rebounds of new fruit agreeing within
+        ``SPEED_SPREAD``), else None; None too when the mass is given (then each fit finds its fruit's speed)."""
+        if not self._reads_speed():
+            return self.analysis.velocity
+        speeds = np.asarray(self._speeds.get(lane, []))
+        if speeds.size < SPEED_MIN_REBOUNDS:
             return None
-        speeds = np.asarray(self._speeds)
         median = float(np.median(speeds))
         spread = float(np.median(np.abs(speeds - median)))
         return median if spread <= SPEED_SPREAD * median else None
 
     def _read_speed(self, lane: int, rebound: PulseSummary, parent: PulseSummary, verdict: Verdict) -> None:
         """Keep the impact speed that ``rebound``'s flight shows, V = g · flight / (2 r), when it is a clear first
-        rebound (not ambiguous) of a measured new fruit of ``lane`` (``line_speed``)."""
-        if self.analysis.velocity is not None or verdict.ambiguous or parent.virtual or not verdict.speed_ratio:
+        rebound (not ambiguous) of a measured new fruit of ``lane`` (``line_speed``).  Its flight was not tested
+        against a speed read so (``PulseSummary.speed_read``), so a lane whose speed changes is read anew."""
+        if not self._reads_speed() or verdict.ambiguous or parent.virtual or not verdict.speed_ratio:
             return
         if not any(fruit.sequence == parent.sequence for fruit in self._fruit.get(lane, [])):
             return  # a rebound's own bounce: its parent's speed is a guess
         flight = rebound.onset - parent.separation
         if flight > 0 and verdict.speed_ratio > 0:
-            self._speeds.append(STANDARD_GRAVITY * flight / (2.0 * verdict.speed_ratio))
-            del self._speeds[:-SPEED_KEPT]
+            kept = self._speeds.setdefault(lane, [])
+            kept.append(STANDARD_GRAVITY * flight / (2.0 * verdict.speed_ratio))
+            del kept[:-SPEED_KEPT]
 
     def _lane_fruit(self, lane: int) -> list[PulseSummary]:
         """The measured new fruit that stand for the next fruit of ``lane``: its own, or, until it has
@@ -508,7 +517,7 @@ class LineAnalyzer:
         """The fruit hidden in the lane's recent overlaps whose rebound is due during ``summary``'s contact
         (``rebounds.unmeasured_fruit``: each the lane's typical fruit at the line's speed, landing at the overlap's
         onset); none without the line's speed or ``LANE_FRUIT_MIN`` measured fruit."""
-        velocity = self.line_speed()
+        velocity = self.line_speed(lane)
         fruit = self._lane_fruit(lane)
         if velocity is None or len(fruit) < LANE_FRUIT_MIN:
             return []
@@ -524,7 +533,7 @@ class LineAnalyzer:
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
         fruit = self._lane_fruit(lane)
-        verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.line_speed())
+        verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.line_speed(lane))
                     for sequence, onset, _ in reversed(recent)]
         return min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
                    else math.inf, default=NEW_FRUIT)

@@ -46,7 +46,7 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
                 "flight_observed": flight, "flight_predicted": None,
                 "peak_observed": candidate.peak_force, "peak_predicted": peak_pred, "speed_ratio": r,
                 "restitution_parent": parent.restitution}
-    if parent.velocity is not None:
+    if parent.velocity is not None and not parent.speed_read:
         predicted = 2.0 * r * parent.velocity / STANDARD_GRAVITY
         evidence["flight_predicted"] = predicted
         deviations["flight"] = abs(math.log(flight / predicted)) / math.hypot(tol["flight"], r_sd) \
@@ -192,7 +192,7 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
                         impulse_sd=math.hypot(EXPECTED_RATIO_SD, parent.impulse_sd), x_sd=guess["x_sd"],
                         restitution_sd=math.hypot(abs(de_dx) * guess["x_sd"], parent.restitution_sd),
                         velocity=r * parent.velocity if parent.velocity is not None else None, refined=True,
-                        virtual=True)
+                        virtual=True, speed_read=parent.speed_read)
 
 
 #: Least spread of the restitution of a lane's fruit and of a predicted rebound's (``rebounds_landed_together``).

@@ -106,9 +106,13 @@ class PulseSummary:
     refined: bool = False
     #: a rebound that landed inside an overlap, as predicted (``hidden_rebound``), not measured
     virtual: bool = False
+    #: its velocity was read from the lane's own rebounds (``LineAnalyzer.line_speed``), not given or fitted: it
+    #: predicts when a rebound is due, but a rebound's flight is not tested against it (a wrong reading would
+    #: reject the very rebounds whose flights correct it)
+    speed_read: bool = False
 
-    def with_velocity(self, velocity: float | None) -> PulseSummary:
-        return replace(self, velocity=velocity)
+    def with_velocity(self, velocity: float | None, read: bool = False) -> PulseSummary:
+        return replace(self, velocity=velocity, speed_read=bool(read and velocity is not None))
 
     def taken(self) -> PulseSummary:
         """The same contact, marked as already having its rebound (a contact rebounds once)."""
