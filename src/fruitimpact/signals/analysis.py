@@ -33,11 +33,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from fruitimpact.impact.validation import InputError
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
@@ -46,7 +44,7 @@ from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummar
                                          from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
                                          likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
                                          shape_table, too_light_for_fruit, unmeasured_fruit)
-from fruitimpact.signals.sort import FirmnessClasses
+from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
 #: Keys of a fit that join the report (a contract: analyze --fit).
@@ -82,8 +80,6 @@ HOLDS_TWO = "_holds_two"
 FITS_AGAIN = 2
 #: Measured new fruit kept per lane: they stand for a fruit hidden in an overlap (``rebounds.judge_unmeasured``).
 LANE_FRUIT_KEPT = 15
-#: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
-DEFAULT_MAX_FLIGHT = 0.3
 #: A lane's impact speed read from its own rebounds when it is not given (``LineAnalyzer.line_speed``): each
 #: clear first rebound of a new fruit flew 2 r V/g (r its speed ratio, measured from the two pulses), so
 #: V = g · flight / (2 r).  It is used once ``SPEED_MIN_REBOUNDS`` of the lane's agree: their median, from the
@@ -93,72 +89,6 @@ DEFAULT_MAX_FLIGHT = 0.3
 SPEED_MIN_REBOUNDS = 4
 SPEED_KEPT = 15
 SPEED_SPREAD = 0.15
-
-
-@dataclass(frozen=True)
-class Analysis:
-    """How contacts are analysed.
-
-    Parameters
-    ----------
-    rate : float
-        Sample rate [Hz].
-    fit : bool
-        Fit the simulator's force law to every contact.
-    velocity, mass : float, optional
-        The fit's knowns (one of them with ``fit``): the line's impact velocity [m/s] (from the drop
-        height) or the fruit mass [kg].  The velocity also predicts rebound flights.
-    diameter, poisson : float, optional
-        Both or neither: the modulus follows from k_c.
-    classes : FirmnessClasses, optional
-        Firmness classes of each new fruit.
-    max_flight : float, optional
-        Longest rebound flight considered [s]; 0 disables rebound detection.  Default: 1.25 × 2V/g +
-        10 ms with a velocity (a fruit cannot come back faster than it came), else 0.3 s.
-    pitch : float, optional
-        The feed's time between fruit of a lane [s], when known: a prior for the rebound decision.
-    """
-
-    rate: float
-    fit: bool = False
-    velocity: float | None = None
-    mass: float | None = None
-    diameter: float | None = None
-    poisson: float | None = None
-    classes: FirmnessClasses | None = None
-    max_flight: float | None = None
-    pitch: float | None = None
-
-    def __post_init__(self):
-        if self.fit and (self.velocity is None) == (self.mass is None):
-            raise InputError("the fit needs exactly one of the impact velocity (--velocity or --drop-height) and "
-                             "the mass (--mass): one pulse determines three of k_c, c, m, V",
-                             "mass" if self.mass is not None else "drop_height")  # the one to take out, or give
-        if (self.diameter is None) != (self.poisson is None):
-            raise ValueError("give both --diameter and --poisson (the modulus follows from k_c with both)")
-        if self.classes is not None and self.classes.by in ("modulus", "stiffness") and not self.fit:
-            raise ValueError(f"classes by {self.classes.by} need --fit")
-        if self.classes is not None and self.classes.by == "modulus" and self.diameter is None:
-            raise ValueError("classes by modulus need --diameter and --poisson")
-        for name in ("max_flight", "pitch"):
-            value = getattr(self, name)
-            low = 0.0 if name == "max_flight" else 1e-3
-            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)
-                                          and low <= value <= 60.0):
-                raise ValueError(f"{name} must be a number of seconds in [{low:g}, 60]; got {value!r}")
-
-    @property
-    def flight_limit(self) -> float:
-        """The longest rebound flight considered [s] (``max_flight`` or its default)."""
-        if self.max_flight is not None:
-            return self.max_flight
-        if self.velocity is not None:
-            return 1.25 * 2.0 * self.velocity / STANDARD_GRAVITY + 0.01
-        return DEFAULT_MAX_FLIGHT
-
-    def analyzer(self) -> LineAnalyzer:
-        """A fresh analyser for one stream (its own lane histories)."""
-        return LineAnalyzer(self)
 
 
 class LineAnalyzer:

@@ -138,7 +138,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
             classes = FirmnessClasses(args.sort_by, thresholds, names)
         except ValueError as exc:
             raise _refusal("--sort-by/--thresholds", str(exc)) from None
-    from fruitimpact.signals.analysis import Analysis
+    from fruitimpact.signals.settings import Analysis  # not the analysis itself: no numba before a usage error
 
     try:
         analysis = Analysis(rate=rate, fit=args.fit, velocity=velocity, mass=mass, diameter=diameter,

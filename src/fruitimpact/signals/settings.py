@@ -1,5 +1,7 @@
-"""Settings of the impact detector (``signals.detect``): what it tracks, its thresholds and windows,
-each value checked at construction with a one-line ``ValueError`` naming it and its allowed range."""
+"""Settings of the impact detector (``signals.detect``): what it tracks, its thresholds and windows, each value
+checked at construction with a one-line ``ValueError`` naming it and its allowed range; and ``Analysis``, how its
+contacts are analysed (``signals.analysis``).  Neither imports the detector or the fits (numba): a usage error is
+answered without them."""
 
 from __future__ import annotations
 
@@ -9,13 +11,20 @@ import numbers
 from dataclasses import dataclass
 
 
+from typing import TYPE_CHECKING
+
 from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_integer, check_number, is_boolean
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+
+if TYPE_CHECKING:
+    from fruitimpact.signals.analysis import LineAnalyzer
+    from fruitimpact.signals.sort import FirmnessClasses
 
 #: Most lanes (force channels) of one recording or stream: analyze, stream and the web app's pages.
 MAX_LANES = 256
 
-__all__ = ["MAX_LANES", "DetectorSettings"]
+__all__ = ["MAX_LANES", "Analysis", "DetectorSettings"]
 
 
 @dataclass(frozen=True)
@@ -131,3 +140,75 @@ def check_rate(rate, argument: str = "rate") -> float | None:
     if not math.isfinite(rate) or not 0.0 < rate <= MAX_RATE:
         raise InputError(f"{argument} must be a finite number of Hz in (0, {MAX_RATE:.0e}]; got {rate!r}", argument)
     return rate
+
+
+#: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
+DEFAULT_MAX_FLIGHT = 0.3
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """How contacts are analysed.
+
+    Parameters
+    ----------
+    rate : float
+        Sample rate [Hz].
+    fit : bool
+        Fit the simulator's force law to every contact.
+    velocity, mass : float, optional
+        The fit's knowns (one of them with ``fit``): the line's impact velocity [m/s] (from the drop
+        height) or the fruit mass [kg].  The velocity also predicts rebound flights.
+    diameter, poisson : float, optional
+        Both or neither: the modulus follows from k_c.
+    classes : FirmnessClasses, optional
+        Firmness classes of each new fruit.
+    max_flight : float, optional
+        Longest rebound flight considered [s]; 0 disables rebound detection.  Default: 1.25 × 2V/g +
+        10 ms with a velocity (a fruit cannot come back faster than it came), else 0.3 s.
+    pitch : float, optional
+        The feed's time between fruit of a lane [s], when known: a prior for the rebound decision.
+    """
+
+    rate: float
+    fit: bool = False
+    velocity: float | None = None
+    mass: float | None = None
+    diameter: float | None = None
+    poisson: float | None = None
+    classes: FirmnessClasses | None = None
+    max_flight: float | None = None
+    pitch: float | None = None
+
+    def __post_init__(self):
+        if self.fit and (self.velocity is None) == (self.mass is None):
+            raise InputError("the fit needs exactly one of the impact velocity (--velocity or --drop-height) and "
+                             "the mass (--mass): one pulse determines three of k_c, c, m, V",
+                             "mass" if self.mass is not None else "drop_height")  # the one to take out, or give
+        if (self.diameter is None) != (self.poisson is None):
+            raise ValueError("give both --diameter and --poisson (the modulus follows from k_c with both)")
+        if self.classes is not None and self.classes.by in ("modulus", "stiffness") and not self.fit:
+            raise ValueError(f"classes by {self.classes.by} need --fit")
+        if self.classes is not None and self.classes.by == "modulus" and self.diameter is None:
+            raise ValueError("classes by modulus need --diameter and --poisson")
+        for name in ("max_flight", "pitch"):
+            value = getattr(self, name)
+            low = 0.0 if name == "max_flight" else 1e-3
+            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)
+                                          and low <= value <= 60.0):
+                raise ValueError(f"{name} must be a number of seconds in [{low:g}, 60]; got {value!r}")
+
+    @property
+    def flight_limit(self) -> float:
+        """The longest rebound flight considered [s] (``max_flight`` or its default)."""
+        if self.max_flight is not None:
+            return self.max_flight
+        if self.velocity is not None:
+            return 1.25 * 2.0 * self.velocity / STANDARD_GRAVITY + 0.01
+        return DEFAULT_MAX_FLIGHT
+
+    def analyzer(self) -> LineAnalyzer:
+        """A fresh analyser for one stream (its own lane histories)."""
+        from fruitimpact.signals.analysis import LineAnalyzer  # the detector and the fits (numba) only now
+
+        return LineAnalyzer(self)

@@ -198,6 +198,17 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         extra.append(Pad(f"pad {pad_modulus / 1e6:.4g} MPa {pad_thickness * 1e3:.4g} mm", pad_modulus, pad_thickness,
                          nu))
     criterion = fruit_criterion(inputs.get("fruit"), criterion, "a sphere audit")
+    # the files before the lot: the lot is checked by an evaluation of one row (the engine, numba: ~0.5 s), and a
+    # log that is not there is answered at once
+    try:
+        windows = read_windows(points) if points is not None else None
+    except ValueError as exc:
+        raise InputError(str(exc), "points") from None
+    try:
+        readings = read_log(log, columns)
+    except ValueError as exc:
+        raise InputError(f"log: {exc}" if not str(exc).startswith("columns") else str(exc),
+                         "columns" if str(exc).startswith("columns") else "log") from None
     read_lot(inputs, rows=1, seed=seed, spreads=spreads, criterion=criterion,
              excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
              excluded_reason="is set by each transfer point the sphere measured")
@@ -216,15 +227,6 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
                             calibration_source=f"calibration {sphere_calibration}", calibrated_sd=half / 1.96)
     else:
         body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson)
-    try:
-        windows = read_windows(points) if points is not None else None
-    except ValueError as exc:
-        raise InputError(str(exc), "points") from None
-    try:
-        readings = read_log(log, columns)
-    except ValueError as exc:
-        raise InputError(f"log: {exc}" if not str(exc).startswith("columns") else str(exc),
-                         "columns" if str(exc).startswith("columns") else "log") from None
     untimed = int(np.count_nonzero(np.isnan(readings.duration)))
     if untimed and restitution is None:
         raise InputError(f"sphere_restitution is needed: {untimed} of {len(readings)} readings have no duration, and "

@@ -60,11 +60,12 @@ when it is met, with its line or sample number, after the chunks before it.
 
 from __future__ import annotations
 
+import numbers
 from pathlib import Path
 
 import numpy as np
 
-from fruitimpact.impact.validation import InputError
+from fruitimpact.impact.validation import InputError, is_boolean
 from fruitimpact.signals.recording import Recording
 from fruitimpact.signals.read.binary import open_f32, open_npy
 from fruitimpact.signals.read.common import (
@@ -152,7 +153,7 @@ def open_recording(path, *, rate: float | None = None, column: str | None = None
     rate = check_rate(rate)
     if column is not None and not isinstance(column, str):
         raise InputError(f"column must be a lane name (a string) or None; got {column!r}", "column")
-    if isinstance(lanes, (bool, np.bool_)) or not isinstance(lanes, (int, np.integer)) or lanes < 1:
+    if is_boolean(lanes) or not isinstance(lanes, numbers.Integral) or lanes < 1:  # NumPy's too, without loading it
         raise InputError(f"lanes must be an integer >= 1 (interleaved lanes of a raw float32 file); got {lanes!r}",
                          "lanes")
     if format is None and Path(path).suffix.lower() not in EXTENSIONS:

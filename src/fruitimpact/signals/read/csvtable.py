@@ -194,9 +194,18 @@ def _rows(path: Path, layout: _Layout):
                 row0 += values.shape[0]
 
 
-#: Bytes that make a line a blank line or the start of one (the lines are then filtered one by one).
-_BLANK_START = np.zeros(256, dtype=bool)
-_BLANK_START[list(b" \t\r\n")] = True
+#: Bytes that make a line a blank line or the start of one (the lines are then filtered one by one); built on
+#: first use, so that importing the reader (``analyze`` answering a missing file) does not load NumPy.
+_BLANK_BYTES = b" \t\r\n"
+_BLANK_TABLE: list = []
+
+
+def _blank_start():
+    if not _BLANK_TABLE:
+        table = np.zeros(256, dtype=bool)
+        table[list(_BLANK_BYTES)] = True
+        _BLANK_TABLE.append(table)
+    return _BLANK_TABLE[0]
 
 
 def _block_values(path, block: bytes, offset: int, first_line: int, row0: int, layout: _Layout):
@@ -218,7 +227,8 @@ def _block_values(path, block: bytes, offset: int, first_line: int, row0: int, l
     lines = numbers = None
     clean = memoryview(block)[:end]
     # a comment or blank line may be anywhere: then the lines are filtered one by one
-    if block.find(b"#", 0, end) >= 0 or _BLANK_START[raw[0]] or _BLANK_START[raw[inner + 1]].any():
+    blank_start = _blank_start()
+    if block.find(b"#", 0, end) >= 0 or blank_start[raw[0]] or blank_start[raw[inner + 1]].any():
         lines = [line.rstrip("\r") for line in block[:end].decode("utf-8").split("\n")]
         keep = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
         numbers = first_line + np.array(keep, dtype=np.int64)
