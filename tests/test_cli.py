@@ -655,7 +655,8 @@ def test_a_failure_caused_by_a_swallowed_ctrl_c_is_answered_as_the_interrupt(mon
                                   ["population", "-n", "-1"], ["stream", "--rate", "0"],
                                   ["sweep", "--mass", "1,2", "--plot", "figure.bogus"], ["simulate", "--mas", "1"],
                                   ["fit-damage", "no-such-tests.csv"], ["analyze", "no-such-recording.csv"],
-                                  ["sphere", "no-such-log.csv", "--criterion", "energy", "--bruise-energy", "0.1J"]])
+                                  ["sphere", "no-such-log.csv", "--criterion", "energy", "--bruise-energy", "0.1J"],
+                                  ["population", "--mass", "0g"], ["sweep", "--restitution", "1.5"]])
 def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_numpy(argv, tmp_path):
     """Issue 15 item 4: ``--help`` and a usage error answer at once (0.25 s), so they may not start numba (0.7 s)
     or NumPy (0.15 s).  The console script itself is run, as a subprocess: ``main()`` in process shares the

@@ -44,7 +44,7 @@ from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_f
 from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from fruitimpact.impact.labels import Labels
 from fruitimpact.impact import fruitfiles
-from fruitimpact.impact.validation import (InputError, MessageBook, WarningBook, choice_message, conflict_message,
+from fruitimpact.impact.validation import (DEPENDENT_INPUTS, InputError, MessageBook, WarningBook, choice_message, conflict_message,
                                            implausible_message, nan_message, range_message)
 
 #: Inputs reported as used (the requested restitution is ``target_restitution``; the damping as used is
@@ -686,8 +686,6 @@ def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluati
     return result
 
 
-#: Inputs whose range depends on other inputs (alpha on the law, step on the impact): not refused alone.
-DEPENDENT_INPUTS = ("alpha", "step")
 
 
 def refuse_constants(constants: dict, text: dict, given=()) -> None:

@@ -118,10 +118,10 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     only with a ``criterion``), except those of ``fixed`` (each evaluation of the lot sets them: a risk map's
     axis).  ``InputError`` naming the input otherwise."""
     from fruitimpact.impact.distributions import Constant, parse_distribution
-    from fruitimpact.impact.evaluation import refuse_constants
     from fruitimpact.impact.presets import lot_distributions
     from fruitimpact.impact.registries import REGISTRIES
-    from fruitimpact.impact.validation import InputError, check_choice, check_conflicts, check_input_name, spec_text
+    from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_input_name,
+                                               refuse_out_of_range, spec_text)
 
     distributions, constants, text = [], {}, {}
     for name, value in inputs.items():
@@ -144,6 +144,9 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     criterion = criterion if criterion is not None else text.get("criterion")
     given = [name for name, _ in distributions] + list(text)
     check_conflicts(given)
+    refuse_out_of_range(constants)  # at once: the one-row evaluation below loads the engine (numba)
+    from fruitimpact.impact.evaluation import refuse_constants
+
     refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
     extra, density, described, bases = lot_distributions(text.get("fruit"),
                                                          [name for name, _ in distributions] + list(fixed),

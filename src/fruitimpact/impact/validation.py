@@ -200,6 +200,24 @@ def check_conflicts(given) -> None:
 _MAX_DIGITS = 4000
 
 
+#: Inputs whose range depends on other inputs (alpha on the law, step on the impact): not refused alone.
+DEPENDENT_INPUTS = ("alpha", "step")
+
+
+def refuse_out_of_range(constants: dict) -> None:
+    """Refuse the first constant input (name → a number [SI]; in the table's order of inputs) outside its allowed
+    range, with the message a row of the table gets (``range_message``), before anything loads the engine: the
+    check a run's one-row evaluation (``evaluation.refuse_constants``) would make first, answered at once (a usage
+    error in ≤ 0.25 s, issue 15 item 4).  ``DEPENDENT_INPUTS`` (a range that depends on other inputs), NaN and
+    what is not a number are left to that evaluation."""
+    for name, quantity in INPUTS.items():
+        value = constants.get(name)
+        if name in DEPENDENT_INPUTS or not isinstance(value, numbers.Real) or is_boolean(value) or math.isnan(value):
+            continue
+        if not quantity.allowed.contains(float(value)):
+            raise InputError(range_message(quantity), name)
+
+
 def read_count(name: str, value, low: int, high: int | None = None) -> int:
     """An exact integer in [low, high] from an int or a text such as ``"10000000"`` or ``"1e7"`` (read as a
     decimal, never through a float, so that a seed above 2^53 keeps every digit); ``InputError`` naming

@@ -17,7 +17,7 @@ from pathlib import Path
 
 
 from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name, is_boolean,
-                                           read_count, spec_text)
+                                           read_count, refuse_out_of_range, spec_text)
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
                                    Plan, Threshold, characteristic, characteristics_list,
                                    check_criterion_for)
@@ -179,7 +179,6 @@ def batch(input, output, *, chunk_size=CHUNK_ROWS, engine=None, scheduler=None, 
 def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = True):
     """(plan, swept axes) of a sweep over ``axes_text`` (input → ``START:STOP:COUNT``, ``log:...``, a comma
     list or one value, in the order given: the first varies slowest)."""
-    from fruitimpact.impact.evaluation import refuse_constants
     from fruitimpact.impact.registries import REGISTRIES
     from fruitimpact.runs.sources import Axis, GridSource, parse_axis
 
@@ -203,6 +202,9 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
         else:
             text[name] = axis.values[0]
     check_conflicts(list(axes_text))
+    refuse_out_of_range(constants)  # at once: the one-row evaluation below loads the engine (numba)
+    from fruitimpact.impact.evaluation import refuse_constants
+
     refuse_constants(constants, text, list(axes_text))
     points = math.prod(len(a.values) for a in axes)
     if points > MAX_ROWS:
