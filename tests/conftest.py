@@ -65,6 +65,16 @@ def cli(capsys) -> CLI:
     return CLI(capsys)
 
 
+def sigint_default() -> None:
+    """``preexec_fn`` of a subprocess that a test sends SIGINT: its SIGINT at the default action, so that Python
+    installs its own handler in it.  A suite started in the background by a shell without job control (``cmd &``,
+    ``nohup ... &``) runs with SIGINT ignored, and an ignored signal stays ignored across exec: such a child would
+    never see the Ctrl-C the test sends (the command ran to its end, or a test accepting exit 0 proved nothing)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def console_script() -> str:
     """The installed ``fruitimpact`` entry point (beside this interpreter, else on PATH)."""
     beside = Path(sys.executable).with_name("fruitimpact")

@@ -476,10 +476,14 @@ def test_a_ctrl_c_that_c_code_turned_into_another_error_is_still_an_interrupt():
         sys.argv = ["fruitimpact", "simulate"]
         sys.exit(cli.main())
     """
-    done = subprocess.run([sys.executable, "-c", script % "True"], capture_output=True, text=True, timeout=60)
+    from conftest import sigint_default
+
+    done = subprocess.run([sys.executable, "-c", script % "True"], capture_output=True, text=True, timeout=60,
+                          preexec_fn=sigint_default)
     assert (done.returncode, done.stdout, done.stderr) == (130, "", "fruitimpact simulate: interrupted\n")
     plain = script.replace("os.kill(os.getpid(), signal.SIGINT)", "pass").replace("time.sleep(5)", "pass")
-    done = subprocess.run([sys.executable, "-c", plain % "True"], capture_output=True, text=True, timeout=60)
+    done = subprocess.run([sys.executable, "-c", plain % "True"], capture_output=True, text=True, timeout=60,
+                          preexec_fn=sigint_default)
     assert done.returncode == 1 and "Traceback" in done.stderr and "PyCapsule_Import" in done.stderr
 
 
@@ -494,12 +498,12 @@ def test_sigint_during_numba_start_up_exits_130_not_by_the_signal():
     import subprocess
     import time
 
-    from conftest import console_script
+    from conftest import console_script, sigint_default
 
     statuses = []
     for k in range(24):
         process = subprocess.Popen([console_script(), "simulate", "--model", "tsuji-clamped"],
-                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default)
         time.sleep(0.55 + 0.35 * k / 23)
         process.send_signal(signal.SIGINT)
         out, err = process.communicate(timeout=60)
@@ -515,10 +519,10 @@ def test_sigint_to_the_console_script_never_shows_a_traceback(delay):
     import subprocess
     import time
 
-    from conftest import console_script
+    from conftest import console_script, sigint_default
 
     process = subprocess.Popen([console_script(), "simulate", "--model", "tsuji-clamped"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default)
     time.sleep(delay)
     process.send_signal(signal.SIGINT)
     out, err = process.communicate(timeout=60)
@@ -570,11 +574,11 @@ def test_ctrl_c_stops_a_long_command_within_a_second(argv, tmp_path):
     import time
     from pathlib import Path
 
-    from conftest import console_script
+    from conftest import console_script, sigint_default
 
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     process = subprocess.Popen([console_script(), *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, cwd=Path(__file__).resolve().parents[1])
+                               text=True, cwd=Path(__file__).resolve().parents[1], preexec_fn=sigint_default)
     time.sleep(8.0)  # past start-up and numba's compilation (cold cache on CI), into the kernels
     assert process.poll() is None, process.communicate()
     sent = time.monotonic()
