@@ -173,6 +173,8 @@ def cmd_analyze(args) -> int:
         progress.update(done, analyzer.impacts, final=True)
     if not args.json:
         print(f"{analyzer.impacts} impacts in {done / source.rate:.4g} s")
+        if analysis.velocity is None and not (analysis.fit and analysis.mass is not None):
+            print(_speeds_read(analyzer.line_speeds()))
     if args.plot:
         from fruitimpact.plotting import save_figure
         from fruitimpact.plotting.signals import analysis_figure
@@ -183,6 +185,17 @@ def cmd_analyze(args) -> int:
         if not args.json:
             print(f"figure written to {args.plot}")
     return 0
+
+
+def _speeds_read(speeds: dict) -> str:
+    """The line of ``analyze``'s summary that says each lane's impact speed read from its rebounds (no drop height
+    given), with the drop it stands for (V²/2g), or that its rebounds gave none."""
+    from fruitimpact.physics.constants import STANDARD_GRAVITY
+
+    parts = [f"{name} {speed:.3g} m/s (a {speed ** 2 / (2.0 * STANDARD_GRAVITY) * 100:.3g} cm drop)"
+             if speed is not None else f"{name} none (fewer than 4 clear rebounds that agree)"
+             for name, speed in speeds.items()]
+    return "impact speed read from each lane's rebounds (no --drop-height given): " + ", ".join(parts)
 
 
 def _reading_error(exc: ValueError, args) -> str:

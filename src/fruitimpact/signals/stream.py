@@ -395,6 +395,11 @@ class StreamAnalyzer:
                 self.close()
         return self.summary()
 
+    def line_speeds(self) -> dict:
+        """Each lane's impact speed [m/s] as the analysis knows it now (``LineAnalyzer.line_speed``: the given one,
+        or the one its rebounds show without a drop height; None when not known), by lane name."""
+        return {name: self._analyzer.line_speed(lane) for lane, name in enumerate(self.lane_names)}
+
     def summary(self) -> dict:
         """Samples per lane, impacts emitted, input problems by kind, and how the stream ended."""
         source = self.source
