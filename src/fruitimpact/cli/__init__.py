@@ -111,6 +111,14 @@ def _answering() -> None:
     _forget_unhandled_interrupt()
 
 
+def _quiet_after_interrupt() -> None:
+    """The command was interrupted and has said so: what fails after, in finalizers run as the process ends, is
+    the interrupt's doing and not reported.  A Ctrl-C inside llvmlite's start-up leaves a half-built object whose
+    ``__del__`` then raises ("Exception ignored in ObjectRef.__del__ … AttributeError", seen once in 24 SIGINTs
+    into `simulate` on a fresh clone), which Python prints as a traceback after the one line."""
+    sys.unraisablehook = lambda unraisable: None
+
+
 def _forget_unhandled_interrupt() -> None:
     """A Ctrl-C during numba's start-up could end the process by SIGINT after main had printed "interrupted" and
     returned 130: exit status -2 in 4 of 72 SIGINTs sent 0.60–0.85 s after the start (tests/test_cli.py saw it
@@ -199,6 +207,7 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         if console:
             _answering()  # first: neither a pending redelivery nor a second Ctrl-C may interrupt this answer
+            _quiet_after_interrupt()
         command = _command(argv)
         print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
         return 130
@@ -209,6 +218,7 @@ def main(argv=None) -> int:
             raise
         if console:
             _answering()
+            _quiet_after_interrupt()
         command = _command(argv)  # a failure caused by a Ctrl-C (swallowed in a C callback, or replaced in C code)
         print(f"{PROG}{' ' + command if command else ''}: interrupted", file=sys.stderr)
         return 130
