@@ -451,6 +451,26 @@ def test_ctrl_c_during_start_up_is_one_line(cli, monkeypatch):
     assert err == "fruitimpact simulate: interrupted\n"
 
 
+def _console_with_parser(body: str, interrupted: bool):
+    """Run the console script's ``main`` (``fruitimpact simulate``) in a fresh interpreter whose parser builder is
+    ``body`` (the lines of a function, indented by 4; ``INTERRUPT`` there is replaced by a real SIGINT to the
+    process, given time to arrive, or by nothing).  Returns the finished process (its SIGINT at the default action:
+    ``conftest.sigint_default``)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    from conftest import sigint_default
+
+    interrupt = "os.kill(os.getpid(), signal.SIGINT); time.sleep(5)" if interrupted else "pass"
+    script = "\n".join(["import atexit, os, signal, sys, time", "import fruitimpact.cli as cli",
+                         "def build_parser():", textwrap.indent(body.replace("INTERRUPT", interrupt), "    "),
+                         "cli.build_parser = build_parser", 'sys.argv = ["fruitimpact", "simulate"]',
+                         "sys.exit(cli.main())"])
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60,
+                          preexec_fn=sigint_default)
+
+
 def test_a_ctrl_c_that_c_code_turned_into_another_error_is_still_an_interrupt():
     """A Ctrl-C inside an import run by C code can come back as another error: NumPy's C extension imports
     datetime through PyCapsule_Import, which replaces the KeyboardInterrupt by an ImportError (seen once in a
@@ -458,32 +478,14 @@ def test_a_ctrl_c_that_c_code_turned_into_another_error_is_still_an_interrupt():
     the parser is built, answered by an ImportError raised outside the handler (no exception chain left, as the
     C code leaves none): one line "interrupted", exit 130, no traceback.  The same ImportError without a Ctrl-C
     is a real failure and keeps its traceback."""
-    import subprocess
-    import sys
-
-    script = """if True:
-        import os, signal, sys, time
-        import fruitimpact.cli as cli
-        def build_parser():
-            caught = False
-            try:
-                os.kill(os.getpid(), signal.SIGINT)
-                time.sleep(5)
-            except KeyboardInterrupt:
-                caught = %s
-            raise ImportError('PyCapsule_Import could not import module "datetime"')
-        cli.build_parser = build_parser
-        sys.argv = ["fruitimpact", "simulate"]
-        sys.exit(cli.main())
-    """
-    from conftest import sigint_default
-
-    done = subprocess.run([sys.executable, "-c", script % "True"], capture_output=True, text=True, timeout=60,
-                          preexec_fn=sigint_default)
+    body = """try:
+    INTERRUPT
+except KeyboardInterrupt:
+    pass
+raise ImportError('PyCapsule_Import could not import module "datetime"')"""
+    done = _console_with_parser(body, interrupted=True)
     assert (done.returncode, done.stdout, done.stderr) == (130, "", "fruitimpact simulate: interrupted\n")
-    plain = script.replace("os.kill(os.getpid(), signal.SIGINT)", "pass").replace("time.sleep(5)", "pass")
-    done = subprocess.run([sys.executable, "-c", plain % "True"], capture_output=True, text=True, timeout=60,
-                          preexec_fn=sigint_default)
+    done = _console_with_parser(body, interrupted=False)
     assert done.returncode == 1 and "Traceback" in done.stderr and "PyCapsule_Import" in done.stderr
 
 
@@ -492,33 +494,16 @@ def test_what_fails_in_finalizers_after_an_interrupt_is_not_a_traceback():
     (seen once on a fresh clone: "Exception ignored in ObjectRef.__del__ … AttributeError" after "interrupted").
     Mimicked: an object whose __del__ raises, alive until the end, and a real SIGINT: one line, exit 130.  The
     same object at the end of a command that was not interrupted is still reported (Python's own report)."""
-    import subprocess
-    import sys
-
-    from conftest import sigint_default
-
-    script = """if True:
-        import atexit, os, signal, sys, time
-        import fruitimpact.cli as cli
-        class HalfBuilt:
-            def __del__(self):
-                raise AttributeError("'_FunctionsIterator' object has no attribute '_as_parameter_'")
-        def build_parser():
-            sys.modules["__main__"].kept = HalfBuilt()
-            atexit.register(lambda: delattr(sys.modules["__main__"], "kept"))  # its __del__ as the process ends
-            if %s:
-                os.kill(os.getpid(), signal.SIGINT)
-                time.sleep(5)
-            raise SystemExit(0)
-        cli.build_parser = build_parser
-        sys.argv = ["fruitimpact", "simulate"]
-        sys.exit(cli.main())
-    """
-    done = subprocess.run([sys.executable, "-c", script % "True"], capture_output=True, text=True, timeout=60,
-                          preexec_fn=sigint_default)
+    body = """class HalfBuilt:
+    def __del__(self):
+        raise AttributeError("'_FunctionsIterator' object has no attribute '_as_parameter_'")
+sys.modules["__main__"].kept = HalfBuilt()
+atexit.register(lambda: delattr(sys.modules["__main__"], "kept"))  # its __del__ as the process ends
+INTERRUPT
+raise SystemExit(0)"""
+    done = _console_with_parser(body, interrupted=True)
     assert (done.returncode, done.stdout, done.stderr) == (130, "", "fruitimpact simulate: interrupted\n")
-    done = subprocess.run([sys.executable, "-c", script % "False"], capture_output=True, text=True, timeout=60,
-                          preexec_fn=sigint_default)
+    done = _console_with_parser(body, interrupted=False)
     assert done.returncode == 0 and "Exception ignored" in done.stderr and "AttributeError" in done.stderr
 
 
