@@ -81,9 +81,10 @@ import numpy as np
 from fruitimpact.engine.codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, KELVIN_VOIGT, KUWABARA_KONO, MAX_PRESSURE,
                     N_CHARACTERISTICS, POWER_LAW, TIME_TO_PEAK)
 from fruitimpact.engine.forces import contact_force, pressure_ratio
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import PARALLEL_MIN_ROWS, fill_characteristics
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT = dict(cache=CACHE, error_model="numpy")
 
 #: Default relative accuracy of the characteristics.
 DEFAULT_RTOL = 1e-10

@@ -17,6 +17,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.codes import ABSORBED_ENERGY, CONTACT_DURATION, EXIT_VELOCITY, MAX_DEFLECTION, PEAK_FORCE, RESTITUTION
+from fruitimpact.engine.jitcache import CACHE
 
 #: Outcomes of ``classify``.
 PHYSICAL = 0
@@ -25,7 +26,7 @@ COLLAPSED = 2
 ENERGY_CREATED = 3
 NO_REBOUND = 4
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT = dict(cache=CACHE, error_model="numpy")
 
 
 @nb.njit(**_JIT)

@@ -14,8 +14,9 @@ import math
 import numba as nb
 
 from fruitimpact.engine.codes import KELVIN_VOIGT, KUWABARA_KONO, POWER_LAW, TSUJI  # noqa: F401  (the family codes)
+from fruitimpact.engine.jitcache import CACHE
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT = dict(cache=CACHE, error_model="numpy")
 
 
 @nb.njit(**_JIT)

@@ -40,9 +40,10 @@ import math
 
 import numba as nb
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import r_func
 
-_JIT = dict(cache=True, fastmath=False, error_model="numpy")
+_JIT = dict(cache=CACHE, fastmath=False, error_model="numpy")
 #: Widest piece in λ = ln(v_b − v) of the plastic line's quadrature (e-folds; 24 nodes reach ~1e-13 over 6).
 LAMBDA_PIECE = 6.0
 

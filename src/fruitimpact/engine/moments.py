@@ -14,8 +14,10 @@ import math
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 
-@nb.njit(cache=True)
+
+@nb.njit(cache=CACHE)
 def _moments(column, mask, out):
     n = 0
     mean = 0.0
@@ -52,7 +54,7 @@ def column_moments(column: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=CACHE)
 def _block_summary(block, columns, ok, chosen, threshold_columns, threshold_ops, threshold_values,
                    moments, counts, sample):
     k = columns.shape[0]

@@ -60,10 +60,11 @@ import numpy as np
 
 from fruitimpact.engine.codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
 from fruitimpact.engine.halfspace import halfspace_impact
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import r_func
 from fruitimpact.engine.quadrature import gauss_jacobi
 
-_JIT = dict(cache=True, fastmath=False, error_model="numpy")
+_JIT = dict(cache=CACHE, fastmath=False, error_model="numpy")
 
 #: Gauss–Legendre nodes per piece of a time integral (the integrands are smooth after substitution).
 NODES = 24

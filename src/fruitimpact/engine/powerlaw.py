@@ -34,6 +34,7 @@ import math
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.quadrature import gauss_jacobi
 
 #: Gauss–Jacobi nodes per integral; the integrands' remaining factors are
@@ -44,10 +45,10 @@ from fruitimpact.engine.codes import (ABSORBED_ENERGY, CHARACTERISTIC_COLUMNS, C
                     EXIT_VELOCITY, FIRMNESS_C, FIRMNESS_C_STAR, MAX_DEFLECTION, MAX_PRESSURE, N_CHARACTERISTICS,
                     PEAK_FORCE, RESTITUTION, TIME_TO_MAX_DEFLECTION, TIME_TO_PEAK)
 
-_JIT = dict(cache=True, fastmath=False, error_model="numpy")
+_JIT = dict(cache=CACHE, fastmath=False, error_model="numpy")
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def fill_characteristics(out, peak_force, time_to_peak, duration, max_deflection, time_to_max,
                          exit_speed, velocity, mass, max_force_ratio, radius):
     """Write one impact's characteristics into ``out`` (CHARACTERISTIC_COLUMNS order)

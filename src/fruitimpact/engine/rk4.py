@@ -19,9 +19,10 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.forces import contact_force, pressure_ratio
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS, N_CHARACTERISTICS, fill_characteristics
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT = dict(cache=CACHE, error_model="numpy")
 
 
 @nb.njit(**_JIT)

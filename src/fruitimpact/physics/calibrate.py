@@ -46,6 +46,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.codes import RESTITUTION
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import exact_x
 
 #: Exact-calibration table of the laws without a first integral: its range in
@@ -156,7 +157,7 @@ def _reference_groups(law, s):
     return np.exp(u)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def _table_groups(e, coefficients, w_min, width, e_min, out):
     """g(e) from the table (Clenshaw); NaN for e outside [TABLE_E_MIN, 1] or NaN."""
     panels = coefficients.shape[0]

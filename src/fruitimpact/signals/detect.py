@@ -76,6 +76,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.filters import butterworth_sos, solve_small
 from fruitimpact.signals.settings import DetectorSettings, check_rate
@@ -208,7 +209,7 @@ CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / 
 #: 1/Φ⁻¹(3/4): σ of normal noise from its median absolute deviation.
 MAD_TO_SIGMA = 1.482602218505602
 
-_JIT = {"cache": True, "error_model": "numpy"}
+_JIT = {"cache": CACHE, "error_model": "numpy"}
 
 
 @nb.njit(**_JIT)

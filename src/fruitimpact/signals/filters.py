@@ -9,6 +9,8 @@ import math
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
+
 __all__ = ["butterworth_sos", "solve_small"]
 
 
@@ -31,7 +33,7 @@ def butterworth_sos(cutoff: float, order: int, rate: float) -> np.ndarray:
     return np.array(rows, dtype=float)
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def solve_small(a, b, n):
     """Solve the leading n × n block of a x = b in place (Gaussian elimination with partial pivoting):
     on return b[:n] holds x.  False (a and b undone only partly) when the block is singular."""

@@ -48,6 +48,7 @@ import numbers
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.filters import solve_small
 
@@ -74,7 +75,7 @@ TAIL_SAMPLES = 4
 EDGE_SNR = 3.0
 _PASSES = 3
 
-_JIT = {"cache": True, "error_model": "numpy"}
+_JIT = {"cache": CACHE, "error_model": "numpy"}
 
 
 @nb.njit(**_JIT)

@@ -15,6 +15,7 @@ import math
 import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.signals.filters import solve_small
 from fruitimpact.signals.pulse import THETA_NODES, X_MAX, PulseModel, _pulse, _theta_coefficients, shape_table
 
@@ -25,7 +26,7 @@ MAX_ITERATIONS = 100
 STEP_TOLERANCE = 1e-3
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=CACHE)
 def _damping_update(cost, cost_trial, predicted, lam, nu):
     """One Levenberg–Marquardt damping decision (Nielsen's update): (step accepted, λ, ν, stop at a minimum)."""
     if cost_trial < cost:
@@ -106,7 +107,7 @@ def levenberg_marquardt(model: PulseModel, y: np.ndarray, theta: np.ndarray, wei
     return theta, jac, r, iterations, converged, message
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=CACHE)
 def _dot(u, v) -> float:
     """u · v (loops: numba's np.dot needs SciPy's BLAS, which fruitimpact does not require)."""
     total = 0.0
@@ -115,7 +116,7 @@ def _dot(u, v) -> float:
     return total
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=CACHE)
 def _quadratic(a, v) -> float:
     """v · (a v)."""
     total = 0.0
@@ -125,7 +126,7 @@ def _quadratic(a, v) -> float:
     return total
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=CACHE)
 def _normal_equations(jac, r, a, g):
     """a = JᵀJ and g = Jᵀr, in place."""
     rows, m = jac.shape
@@ -144,7 +145,7 @@ def _normal_equations(jac, r, a, g):
             a[i, j] = a[j, i]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, r, jac, want,
                    a, da, part, part_jac):
     """Weighted residuals of a sum of pulses (θ in blocks of (t0, ln F_max, ln T, x)) and the prior rows, and
@@ -173,7 +174,7 @@ def _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior
             jac[n + k, prior_index[k]] = prior_weight[k]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, max_iterations,
                   step_tolerance, x_max):
     """``levenberg_marquardt`` for a sum of pulses with Gaussian priors on some parameters, compiled: the same

@@ -29,6 +29,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.codes import CONTACT_DURATION, PEAK_FORCE
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import powerlaw_characteristics, powerlaw_curves_batch
 
 __all__ = ["PulseModel", "STIFFNESS_SCALE", "THETA_NODES", "X_MAX", "shape_table", "shape_table_error", "table_shape"]
@@ -80,7 +81,7 @@ def shape_table() -> tuple[np.ndarray, float]:
     return _TABLE[0]
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def _theta_coefficients(x, coefficients, width, a, da):
     """Chebyshev coefficients in θ of H(·; x) into ``a`` and their x derivatives into ``da``."""
     v = math.log1p(x)
@@ -107,7 +108,7 @@ def _theta_coefficients(x, coefficients, width, a, da):
             da[j] += coefficients[panel, k, j] * d_k * scale
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=CACHE, error_model="numpy")
 def _pulse(t, t0, peak, duration, a, da, model, jacobian):
     """F = peak · H((t − t0)/duration) at each t (ascending) and, if ``jacobian`` has rows, ∂F/∂(t0, ln peak,
     ln duration, x) there (H from the θ coefficients ``a``, ∂H/∂x from ``da``).  The Chebyshev recurrences run
