@@ -70,6 +70,9 @@ def main() -> None:
         ("fruitimpact --help", wall([exe, "--help"]), "s", "python -c pass", bare, "", "≤ 0.25 s"),
         ("fruitimpact simulate --mass -1 (usage error)", wall([exe, "simulate", "--mass", "-1"]), "s",
          "python -c pass", bare, "", "≤ 0.25 s"),
+        ("population --fruit pear --criterion shear (usage)",
+         wall([exe, "population", "-n", "10", "--fruit", "pear", "--criterion", "shear"]), "s", "python -c pass", bare,
+         "", "≤ 0.25 s"),
         ("fruitimpact simulate (warm cache)", wall([exe, "simulate"], 5), "s", "python -c pass", bare, "",
          "≤ 0.4 s"),
     ]

@@ -700,6 +700,40 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
     assert not {name for name in imported if name.split(".")[0] in ("numba", "numpy")}, argv
 
 
+
+@pytest.mark.parametrize("argv, line", [
+    (["population", "-n", "10", "--fruit", "pear", "--criterion", "shear"],
+     "argument --failure-stress: failure_stress is not in the pear entry of the fruit library"),
+    (["safe-height", "--fruit", "pear", "--criterion", "energy"],
+     "argument --bruise-energy: bruise_energy must be given for the energy criterion"),
+    (["population", "-n", "10", "--model", "tsuji", "--yield-pressure", "1MPa"],
+     "argument --yield-pressure: plastic contact (--yield-pressure, --bioyield-force) and cushion layers are built "
+     "on the power-law family"),
+    (["line", "--fruit", "pear", "--criterion", "energy", "LINE"], "argument --bruise-energy: bruise_energy must be given")])
+def test_a_usage_error_that_needs_the_fruit_library_starts_no_numba(argv, line, tmp_path):
+    """Issue 15 item 4: a refusal that needs the library's presets (a criterion whose input the fruit lacks, a law
+    that cannot carry plastic contact) is found by the row validation of ``impact.evaluation``, which loads NumPy
+    (0.1 s) but not the compiled engine (numba, 0.7 s): it loads only where a row is computed.  Each was a 0.8–1 s
+    answer before; a population of identical refusals (``--model tsuji --yield-pressure``) was 10 invalid rows
+    and exit 0."""
+    import os
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    from conftest import console_script
+
+    shutil.copy(Path(__file__).parents[1] / "examples" / "line.csv", tmp_path / "line.csv")
+    argv = [str(tmp_path / "line.csv") if a == "LINE" else a for a in argv]
+    env = {**os.environ, "PYTHONPROFILEIMPORTTIME": "1"}
+    done = subprocess.run([console_script(), *argv], capture_output=True, text=True, cwd=tmp_path, env=env,
+                          timeout=60)
+    messages = [text for text in done.stderr.splitlines() if not text.startswith("import time:")]
+    assert done.returncode == 2 and len(messages) == 1 and line in messages[0], done.stderr[-2000:]
+    imported = {text.rsplit("|", 1)[-1].strip() for text in done.stderr.splitlines() if text.startswith("import time:")}
+    assert "fruitimpact.impact.evaluation" in imported  # the log is there and the validation ran: can fail
+    assert not {name for name in imported if name.split(".")[0] == "numba"}, argv
+
 @pytest.mark.parametrize("argv, line", [
     (["serve", "--port", "²"], "argument --port: port must be an integer in [0, 65,535]; got '²'"),
     (["serve", "--port", "70000"], "argument --port: port must be an integer in [0, 65,535]; got '70000'"),

@@ -11,7 +11,9 @@
   Kuwabara–Kono, linear Kelvin–Voigt);
 * ``rk4``: the founding paper's fixed-step RK4 (section 3), to reproduce its method;
 * ``quadrature``: Gauss–Jacobi rules; ``checks``: physical checks of computed rows;
-  ``moments``: streaming moments of a column.
+  ``moments``: streaming moments of a column;
+* ``plasticforms``: Thornton's yield force and the Winkler layer in closed form (plain NumPy, no numba);
+* ``jitcache``: numba's on-disk cache keyed on every file a compiled function may depend on.
 
 No I/O, no units, no pandas, SciPy or plotting (an import-linter contract).
 """

@@ -61,6 +61,8 @@ import numpy as np
 from fruitimpact.engine.codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
 from fruitimpact.engine.halfspace import halfspace_impact
 from fruitimpact.engine.jitcache import CACHE
+from fruitimpact.engine.plasticforms import (N_PLASTIC, PLASTIC_COLUMNS, winkler_stiffness,  # noqa: F401  (re-exported)
+                                             yield_force, yield_pressure_of_force)
 from fruitimpact.engine.powerlaw import r_func
 from fruitimpact.engine.quadrature import gauss_jacobi
 
@@ -74,37 +76,6 @@ NODES = 24
 HALFSPACE_DAMPING_LIMIT = 0.9
 #: Rows from which the parallel kernel is used.
 PARALLEL_MIN_ROWS = 2000
-
-#: Columns of the plastic block, after the characteristics.
-PLASTIC_COLUMNS = ("yield_velocity", "permanent_deflection", "plastic_work", "viscous_work", "yield_force",
-                   "bottomed_out", "fruit_work_share", "unloading_radius")
-N_PLASTIC = len(PLASTIC_COLUMNS)
-
-
-def yield_force(contact_modulus, radius, yield_pressure):
-    """Thornton's yield force F_y = π³ p_y³ R² / (6 E*²) [N] (TN98 eq 16): the force at which the
-    Hertz centre pressure reaches the limiting contact pressure p_y [Pa]; E* [Pa], R [m]."""
-    return math.pi ** 3 * np.asarray(yield_pressure, dtype=float) ** 3 * np.square(radius) / \
-        (6.0 * np.square(contact_modulus))
-
-
-def yield_pressure_of_force(contact_modulus, radius, force):
-    """The limiting pressure p_y [Pa] whose Thornton yield force is ``force`` [N]: the inverse of
-    ``yield_force``, p_y = (6 E*² F / (π³ R²))^(1/3).  The founding paper's bioyield critical force
-    F_pc (its eq 17) is read as F_y."""
-    return np.cbrt(6.0 * np.square(contact_modulus) * np.asarray(force, dtype=float) /
-                   (math.pi ** 3 * np.square(radius)))
-
-
-def winkler_stiffness(modulus, poisson, thickness, radius):
-    """K_L = π k R [N/m²] of an elastic-foundation layer under a sphere of radius R [m]:
-    F = K_L δ², k = (1−ν)E/((1+ν)(1−2ν)h) [N/m³] (a laterally confined layer of thickness h [m]
-    on a rigid substrate; Simbody ``ElasticFoundationForce``)."""
-    poisson = np.asarray(poisson, dtype=float)
-    k = (1.0 - poisson) * np.asarray(modulus, dtype=float) / ((1.0 + poisson) * (1.0 - 2.0 * poisson) *
-                                                              np.asarray(thickness, dtype=float))
-    return math.pi * k * np.asarray(radius, dtype=float)
-
 
 # ---------------------------------------------------------------------------------------------
 # the branches, parametrised by the rate-independent force F (p: the row's parameters)

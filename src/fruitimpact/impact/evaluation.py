@@ -27,17 +27,14 @@ import numpy as np
 from fruitimpact.library import catalogue as library
 from fruitimpact.physics import hertz as contact
 from fruitimpact.physics.hertz import hertz_contact_duration
-from fruitimpact.physics.calibrate import TABLE_E_MIN
-from fruitimpact.physics.calibrate import damping_factor as calibrated_damping_factor
 from fruitimpact.physics.constants import STANDARD_GRAVITY
-from fruitimpact.engine.powerlaw import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
+from fruitimpact.engine.codes import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
 from fruitimpact.impact.inputs import InputColumns, read_columns
 from fruitimpact.physics import DAMPING_LAWS
 from fruitimpact.impact.registries import REGISTRIES
 from fruitimpact.impact import presets
 from fruitimpact.damage.assess import CRITERION_NAMES, bruise_columns
-from fruitimpact.engine.plastic import (PLASTIC_COLUMNS, crushing_characteristics, plastic_characteristics, winkler_stiffness,
-                             yield_pressure_of_force)
+from fruitimpact.engine.plasticforms import PLASTIC_COLUMNS, winkler_stiffness, yield_pressure_of_force
 from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
                          NUMERIC_INPUTS, PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
 from fruitimpact.impact.solvers import SOLVERS, max_rk4_step, power_law_closed_forms
@@ -353,6 +350,10 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
             rows_sub, sub_sel = _selection(sub, idx, sel)
             if rows_sub.size == 0:
                 continue
+            # the compiled engine is loaded where a row is computed, not to validate one (a usage error in 0.25 s)
+            from fruitimpact.physics.calibrate import TABLE_E_MIN
+            from fruitimpact.physics.calibrate import damping_factor as calibrated_damping_factor
+
             factor[sub_sel] = calibrated_damping_factor(law, calibration, target[sub_sel], mass[sub_sel],
                                                         stiffness[sub_sel], velocity[sub_sel])
             if calibration == "exact" and not family.first_integral and not law.exact_by_construction:
@@ -635,6 +636,8 @@ def _damage_columns(out, plastic_block, done, mass, velocity, used, inputs, frui
 def _plastic_engine(crushing: np.ndarray, *columns):
     """The plastic engine of rows (``columns`` as for ``plastic_characteristics``), the rows on a board that
     crushes (``crushing``, one flag per row: sliced with the rows by ``in_slices``) by the crushing engine."""
+    from fruitimpact.engine.plastic import crushing_characteristics, plastic_characteristics
+
     if crushing.all():
         return crushing_characteristics(*columns)
     if not crushing.any():
@@ -697,11 +700,13 @@ def refuse_constants(constants: dict, text: dict, given=()) -> None:
         return
     probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
     message = probe.messages.text(0)
-    first = message.split(" ", 1)[0]
-    if probe.status[0] != INVALID or first in DEPENDENT_INPUTS:
+    # the input a refusal names (its argument), else its first word: "plastic contact (--yield-pressure ...)"
+    # is about yield_pressure
+    name = probe.messages.argument(0) or message.split(" ", 1)[0]
+    if probe.status[0] != INVALID or name in DEPENDENT_INPUTS:
         return
-    if first in set(constants) | set(text) or (first in INPUTS and first not in set(given)):
-        raise InputError(message, first)
+    if name in set(constants) | set(text) or (name in INPUTS and name not in set(given)):
+        raise InputError(message, name)
 
 
 def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.DataFrame":  # noqa: F821
