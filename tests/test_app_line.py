@@ -38,10 +38,11 @@ def _strict(report: dict) -> dict:
 
 
 def _points(rows: list[dict]) -> list[TransferPoint]:
+    from fruitimpact.handling.line import measured_surface
     from fruitimpact.impact.units import parse_quantity
 
-    return [TransferPoint(r["name"], parse_quantity(r["drop_height"], "length"), r["surface"], r["fruit_on_fruit"])
-            for r in rows]
+    return [TransferPoint(r["name"], parse_quantity(r["drop_height"], "length"), r["surface"], r["fruit_on_fruit"],
+                          *measured_surface(r, r["name"])) for r in rows]
 
 
 def read_line_text(text: str) -> list[TransferPoint]:
@@ -319,6 +320,22 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
         line[0], line[1] = line[1], line[0]
         assert view.evaluate("window.fruitimpact.last.report.points.length") == 5
 
+        # a measured half-space typed beside a point (a sphere's reading of the bin tipper): audit_line of that line
+        assert "unused" in view.get_attribute('#points tr.point[data-index="3"] [data-column=surface_modulus]',
+                                              "class")  # the accumulation table: fruit on fruit, no surface met
+        view.fill('#points tr.point[data-index="1"] [data-column=surface_modulus]', "50MPa")
+        view.fill('#points tr.point[data-index="1"] [data-column=surface_poisson]', "0.45")
+        _wait(view, "window.fruitimpact.last.report.points[1].surface_modulus === 50e6")
+        line[1].update(surface_modulus="50MPa", surface_poisson="0.45")
+        reference = fi.audit_line(_points(line), rows=page.PAGE_ROWS, seed=0, fruit="apple")
+        library = fi.audit_line(_points([{**row, "surface_modulus": "", "surface_poisson": ""} for row in line]),
+                                rows=page.PAGE_ROWS, seed=0, fruit="apple")
+        volume = reference["points"][1]["mean_bruise_volume"]
+        assert volume != pytest.approx(library["points"][1]["mean_bruise_volume"], rel=1e-2)  # it matters: can fail
+        assert _shown(view, 1, "mean_bruise_volume") == pytest.approx(volume * 1e9, rel=5e-4)
+        assert _shown(view, 1, "incidence") == pytest.approx(reference["points"][1]["incidence"] * 100, rel=5e-3)
+        assert view.locator(".field-error").count() == 0
+
         # a what-if: the saving is the paired difference of the two library audits
         updates = view.evaluate("window.fruitimpact.updates")
         view.select_option("#what-if-point", "packing into the carton")
@@ -336,7 +353,8 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
         with view.expect_download() as download:
             view.click("[data-export=csv]")
         lines = open(download.value.path(), encoding="utf-8").read().splitlines()
-        assert lines[0].startswith("name,drop_height_m,surface,fruit_on_fruit") and len(lines) == 6
+        assert lines[0].startswith("name,drop_height_m,surface,fruit_on_fruit,surface_modulus_Pa,surface_poisson") \
+            and len(lines) == 6
         with view.expect_download() as download:
             view.click("[data-export=line]")
         assert download.value.suggested_filename == "line.csv"

@@ -9,7 +9,7 @@ const statusLine = document.getElementById("status");
 const whatIfPoint = document.getElementById("what-if-point");
 const whatIfSurface = document.getElementById("what-if-surface");
 const COLORS = {here: "#2b5f9e", sofar: "#a9c1de", volume: "#8a4b9c", volumeSofar: "#d3bddb"};
-const COLUMNS = 11;  // of the line's table
+const COLUMNS = 12;  // of the line's table
 let choices = null, last = null, timer = null, inFlight = false, pending = false, changedAt = null;
 // The sphere's uploads ({upload, file, size}, by the input naming them), its last answer and the upload limit.
 const sphereFiles = {log: null, sphere_calibration: null};
@@ -41,7 +41,15 @@ function addRow(point, after) {
   const flag = make("input", {type: "checkbox", checked: point.fruit_on_fruit, ariaLabel: "fruit on fruit"});
   name.dataset.column = "name"; height.dataset.column = "drop_height";
   surface.dataset.column = "surface"; flag.dataset.column = "fruit_on_fruit";
-  tr.append(cell("index"), cell("name", name), cell("height", height), cell("surface", surface), cell("flag", flag));
+  // a measured half-space (e.g. a sphere's reading): the line CSV's optional surface_modulus and surface_poisson,
+  // both or neither; blank: the library surface's own
+  const measured = make("td", {className: "measured"});
+  for (const [column, label, hint] of [["surface_modulus", "measured surface modulus", "E"], ["surface_poisson", "measured surface Poisson's ratio", "ν"]]) {
+    const input = make("input", {type: "text", value: point[column] ?? "", placeholder: hint, ariaLabel: label});
+    input.dataset.column = column;
+    measured.append(input);
+  }
+  tr.append(cell("index"), cell("name", name), cell("height", height), cell("surface", surface), cell("flag", flag), measured);
   for (const out of ["incidence", "mean_bruise_volume", "cumulative_incidence", "cumulative_bruise_volume", "mean_peak_force"]) {
     const td = cell("out");
     td.dataset.out = out;
@@ -69,8 +77,12 @@ function renumber() {
     tr.querySelector("[data-action=remove]").disabled = all.length === 1;
     const onFruit = tr.querySelector("[data-column=fruit_on_fruit]").checked;
     const surface = tr.querySelector("[data-column=surface]");
+    const measured = [...tr.querySelectorAll("td.measured input")];
+    const isMeasured = measured.some((input) => input.value.trim());
     surface.classList.toggle("unused", onFruit);
-    surface.title = onFruit ? "the fruit lands on a resting fruit: this surface is not met" : "";
+    surface.title = onFruit ? "the fruit lands on a resting fruit: this surface is not met"
+      : isMeasured ? "names the measured surface; its modulus and Poisson's ratio are those typed beside" : "";
+    for (const input of measured) input.classList.toggle("unused", onFruit);
   });
   refreshWhatIf();
 }
@@ -81,6 +93,8 @@ function tableRows() {
     drop_height: tr.querySelector("[data-column=drop_height]").value,
     surface: tr.querySelector("[data-column=surface]").value,
     fruit_on_fruit: tr.querySelector("[data-column=fruit_on_fruit]").checked,
+    surface_modulus: tr.querySelector("[data-column=surface_modulus]").value,
+    surface_poisson: tr.querySelector("[data-column=surface_poisson]").value,
   }));
 }
 
@@ -318,7 +332,7 @@ function verdict(box, prefix, {lotLabel, incidence, interval, volume, worst, det
 function renderVerdict(answer, worst) {
   const report = answer.report;
   const point = report.points[worst];
-  const onto = point && (point.fruit_on_fruit ? "onto fruit" : `onto ${point.surface}`);
+  const onto = point && (point.fruit_on_fruit ? "onto fruit" : point.surface_modulus ? `onto ${point.surface} (measured: ${fmt(point.surface_modulus / 1e6, 3)} MPa, ν ${fmt(point.surface_poisson, 2)})` : `onto ${point.surface}`);
   verdict(document.getElementById("verdict"), "", {
     status: report.status, message: report.message,
     lotLabel: `criterion ${report.criterion}, ${lotText(report)}`, incidence: report.incidence,
@@ -525,7 +539,7 @@ async function exportAs(kind) {
   if (kind === "line") download(last.file, new Blob([last.line_csv], {type: "text/csv"}));
   if (kind === "csv") {
     const columns = [["name", "name"], ["drop_height", "drop_height_m"], ["surface", "surface"], ["fruit_on_fruit", "fruit_on_fruit"],
-      ["velocity", "velocity_m_s"], ["incidence", "incidence"], ["mean_bruise_volume", "mean_bruise_volume_m3"],
+      ["surface_modulus", "surface_modulus_Pa"], ["surface_poisson", "surface_poisson"], ["velocity", "velocity_m_s"], ["incidence", "incidence"], ["mean_bruise_volume", "mean_bruise_volume_m3"],
       ["cumulative_incidence", "cumulative_incidence"], ["cumulative_bruise_volume", "cumulative_bruise_volume_m3"],
       ["mean_peak_force", "mean_peak_force_N"], ["mean_max_pressure", "mean_max_pressure_Pa"], ["invalid", "invalid"], ["failed", "failed"]];
     const lines = [columns.map(([, header]) => header).join(","),
@@ -581,7 +595,7 @@ function setUp(answer) {
 function onTableEdit(event) {
   const target = event.target;
   if (!target.dataset.column) return;
-  if (target.dataset.column === "fruit_on_fruit" || target.dataset.column === "surface" || target.dataset.column === "name") renumber();
+  if (["fruit_on_fruit", "surface", "name", "surface_modulus", "surface_poisson"].includes(target.dataset.column)) renumber();
   schedule(target.type === "text" ? 200 : 10);  // typing: wait for a pause
 }
 
