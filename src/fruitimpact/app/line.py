@@ -9,8 +9,8 @@ optionally, ``what_if``: ``{"point": name, "surface": surface}``.  A name left o
 ``points`` the example line (``examples/line.csv``), without ``fruit`` an apple, without ``rows``
 :data:`PAGE_ROWS` fruit.  Unknown names are refused, as the CLI refuses an unknown option.
 
-Each row of the table is read as ``read_line`` reads a row of a line CSV, with the library's own checks
-(``parse_quantity``, ``_checked_point``): a refused cell gets the line the CLI prints for the same row of
+Each row of the table is read by ``read_point``, as ``read_line`` reads a row of a line CSV, with the library's
+own checks (``parse_quantity``, ``_checked_point``): a refused cell gets the line the CLI prints for the same row of
 ``line.csv`` (``argument LINE: line.csv, line 3: drop_height: …``) and names the cell, ``["points", 1,
 "drop_height"]``, for the page to show the line next to it.  The answer carries that ``line.csv`` and the
 ``fruitimpact line line.csv …`` command that reproduces the audit to the last digit (the same lot: same seed,
@@ -24,12 +24,10 @@ import shlex
 
 from fruitimpact.app.inputs import typed_value
 from fruitimpact.handling.line import (DEFAULT_ALTERNATIVES, LINE_COLUMNS, MAX_LINE_FRUIT, MAX_POINTS,
-                                      MEASURED_SURFACE_COLUMNS, TransferPoint, measured_surface,
-                                      _checked_point, _distinct)
+                                      MEASURED_SURFACE_COLUMNS, TransferPoint, _distinct, read_point)
 from fruitimpact.impact.outputs import json_safe
 from fruitimpact.impact.quantities import option_of
 from fruitimpact.impact.validation import InputError, read_count, usage_message
-from fruitimpact.library.textfiles import yes_or_no
 
 #: The file the page's line is saved as, and the name its command and its messages give it.
 LINE_FILE = "line.csv"
@@ -89,13 +87,11 @@ def _cell_text(value) -> str | None:
 
 
 def read_points(points) -> tuple[list[TransferPoint], list[dict]]:
-    """The transfer points of the page's table, each row read as ``read_line`` reads a row of ``line.csv``
-    (heights by ``parse_quantity``, every point by ``_checked_point``, names by ``_distinct``), with the CLI's
+    """The transfer points of the page's table, each row read by ``read_point`` as ``read_line`` reads a row of
+    ``line.csv`` (names told apart by ``_distinct``), once its cells are texts (or the flag a bool), with the CLI's
     words for a refused cell; and the rows as the CSV holds them (texts), for ``line.csv`` and the page.
 
     ``InputError`` with ``argument`` ``["points", index, column]`` for a cell, ``"points"`` for the table."""
-    from fruitimpact.impact.units import parse_quantity
-
     if not isinstance(points, list) or not all(isinstance(row, dict) for row in points):
         raise InputError("points must be a list of transfer points, each an object with "
                          f"{', '.join(LINE_COLUMNS)}", "points")
@@ -121,29 +117,19 @@ def read_points(points) -> tuple[list[TransferPoint], list[dict]]:
                 raise refused(f"{where}: {column} must be a number or a text; got {row[column]!r}", column)
         if "\n" in cells["name"] or "\r" in cells["name"]:  # one row of the CSV: a name on one line
             raise refused(f"{where}: name must be one line of text; got {cells['name']!r}", "name")
-        flag = row.get("fruit_on_fruit", False)
-        if not isinstance(flag, bool):
-            answer = yes_or_no(flag, blank=False) if isinstance(flag, str) else None
-            if answer is None:
-                raise refused(f"{where}: fruit_on_fruit must be true or false; got {flag!r}", "fruit_on_fruit")
-            flag = answer
-        try:
-            height = parse_quantity(cells["drop_height"], "length")
-        except ValueError as error:
-            raise refused(f"{where}: drop_height: {error}", "drop_height") from None
         measured = {}
         for column in MEASURED_SURFACE_COLUMNS:  # optional: absent, null (as the report writes it) or "" is blank
             measured[column] = _cell_text("" if row.get(column) is None else row[column])
             if measured[column] is None:
                 raise refused(f"{where}: {column} must be a number or a text; got {row[column]!r}", column)
+        flag = row.get("fruit_on_fruit", False)
         try:
-            point = _checked_point(TransferPoint(cells["name"], height, cells["surface"], flag,
-                                                 *measured_surface(measured, where)), where)
+            point = read_point({**cells, "fruit_on_fruit": flag, **measured}, where)
         except ValueError as error:  # "<where>: <column> must be …" or "<where>: <column>: …": that column's cell
             column = str(error)[len(where) + 2:].split(" ", 1)[0].rstrip(":")
             raise refused(str(error), column if column in LINE_COLUMNS else "name") from None
         read.append(point)
-        rows.append({**cells, "fruit_on_fruit": flag, **{k: v for k, v in measured.items() if v}})
+        rows.append({**cells, "fruit_on_fruit": point.fruit_on_fruit, **{k: v for k, v in measured.items() if v}})
     try:
         _distinct(read, LINE_FILE)
     except ValueError as error:

@@ -103,8 +103,6 @@ def read_line(path) -> list[TransferPoint]:
     import csv
     import os
 
-    from fruitimpact.impact.units import parse_quantity
-
     if not isinstance(path, (str, os.PathLike)):  # an integer would be taken as a file descriptor, and closed
         raise ValueError(f"line must be a path to a line CSV; got {path!r}")
     lines = list(table_lines(path))
@@ -136,18 +134,28 @@ def read_line(path) -> list[TransferPoint]:
         where = f"{path}, line {number}"
         if len(row) != len(header):
             raise ValueError(f"{where}: {len(row)} fields, the header has {len(header)}")
-        cells = dict(zip(header, (cell.strip() for cell in row)))
-        try:
-            height = parse_quantity(cells["drop_height"], "length")
-        except ValueError as exc:
-            raise ValueError(f"{where}: drop_height: {exc}") from None
-        flag = yes_or_no(cells.get("fruit_on_fruit", ""), blank=False)
-        if flag is None:
-            raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {cells['fruit_on_fruit']!r}")
-        modulus, poisson = measured_surface(cells, where)
-        points.append(_checked_point(TransferPoint(cells["name"], height, cells["surface"], flag, modulus, poisson),
-                                     where))
+        points.append(read_point(dict(zip(header, (cell.strip() for cell in row))), where))
     return _distinct(points, str(path))
+
+
+def read_point(cells: dict, where: str) -> TransferPoint:
+    """One transfer point from a row's cells as a line CSV holds them (texts: heights and moduli with units,
+    ``fruit_on_fruit`` true/false/yes/no/1/0 or blank, or already a bool as the web page sends it), checked as every
+    point is (``_checked_point``).  ``ValueError`` "<where>: <column> …" naming the first refused cell."""
+    from fruitimpact.impact.units import parse_quantity
+
+    try:
+        height = parse_quantity(cells["drop_height"], "length")
+    except ValueError as exc:
+        raise ValueError(f"{where}: drop_height: {exc}") from None
+    flag = cells.get("fruit_on_fruit", "")
+    if not isinstance(flag, bool):
+        answer = yes_or_no(flag, blank=False) if isinstance(flag, str) else None
+        if answer is None:
+            raise ValueError(f"{where}: fruit_on_fruit must be true or false; got {flag!r}")
+        flag = answer
+    modulus, poisson = measured_surface(cells, where)
+    return _checked_point(TransferPoint(cells["name"], height, cells["surface"], flag, modulus, poisson), where)
 
 
 def _distinct(points: list, where: str) -> list:
@@ -360,7 +368,8 @@ def _or_zero(value: float) -> float:
 
 
 __all__ = ["DEFAULT_ALTERNATIVES", "LINE_COLUMNS", "LINE_FRUIT", "MAX_LINE_FRUIT", "MAX_POINTS",
-           "MEASURED_SURFACE_COLUMNS", "Pad", "TransferPoint", "audit", "audit_line", "measured_surface", "read_line"]
+           "MEASURED_SURFACE_COLUMNS", "Pad", "TransferPoint", "audit", "audit_line", "measured_surface", "read_line",
+           "read_point"]
 
 
 #: Highest drop a transfer point may have [m] (the safe-height search's own ceiling, ``heights.HIGHEST``).
