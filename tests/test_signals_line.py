@@ -34,6 +34,7 @@ That is the bug the issue is about; the goals are not relaxed for it.
 from __future__ import annotations
 
 import ast
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -333,3 +334,33 @@ def test_line_grading_meets_the_issue_goal(cli, tmp_path):
     # a clear fruit on which a rebound landed is told apart and graded, or is an overlap without a class (item 2:
     # a piece whose peak the samples do not fix to ±1 % gets none): never a wrong class (0 of 16 at benchmark size)
     assert g["overlapped_wrong"] == 0, (g["overlapped_clear"], g["overlapped_right"], g["confusion"])
+
+
+def test_a_fruit_and_two_rebounds_within_ten_milliseconds(cli, tmp_path):
+    """chain10 at seed 9 (10 fruit/s: the pitch is the rebound's flight 2eV/g) holds two contacts of three pulses.
+    At 1.4987 s a fruit lands, and 6.4 and 8.4 ms later the second rebound of one fruit and the first of the next:
+    the merged contact has no clean falling edge (its duration index is NaN), and the rebounds due in it were not
+    looked for, so the joint fit took the two rebounds for one fruit (F 67 N: the two 38–40 N pulses).  Now the
+    contact as detected bounds where a rebound may be due; both are found, as rebounds.  At 1.1994 s a fruit lands
+    1.8 and 3.3 ms before two rebounds; two of the three pulses cannot be told apart, and the piece left beside
+    them had absorbed part of one (F 66 N for a 39 N rebound) and was taken for a fruit: a piece fitted beside a
+    pair the samples do not separate is no measurement (``analysis.reports``), so it is an overlap, never a
+    fruit's grade.  Regression cases of the independent generator, scored as the scorecard scores them."""
+    scenario = lg.SCENARIOS["chain10"]
+    path, truth = lg.write(dataclasses.replace(scenario, seed=9), tmp_path)
+    status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))
+    assert status == 0, err
+    reports = [json.loads(line) for line in out.splitlines()]
+    m = lg.match(reports, truth)
+    report_of = {c["index"]: r for c, r in m["pairs"]}
+    covered = {c["index"] for c in m["covered"]}
+    for onset in (1.50509, 1.50708):  # the two rebounds behind the fruit at 1.49868
+        contact = next(c for c in truth["contacts"] if abs(c["start_time"] - onset) < 5e-5)
+        assert contact["is_rebound"] and contact["index"] in report_of, onset
+        assert report_of[contact["index"]]["rebound"], report_of[contact["index"]]
+    near = [r for r in reports if 1.199 < r["start_time"] < 1.204]
+    fruit = next(c for c in truth["contacts"] if abs(c["start_time"] - 1.19942) < 5e-5)
+    assert fruit["index"] in report_of or fruit["index"] in covered
+    assert all(r["status"] == "overlap" or r["rebound"] for r in near[1:]), near  # the pieces after the fruit's
+    card = lg.score(reports, truth)
+    assert card["rebounds_taken_for_fruit"] == 0 and card["missed"] == 0, card
