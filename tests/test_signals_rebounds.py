@@ -942,6 +942,37 @@ def test_a_contact_a_hidden_fruits_rebound_explains_only_a_little_better_than_a_
     assert strong.rebound and strong.parent == 42, ev
 
 
+
+def test_a_hidden_fruits_rebound_in_the_ambiguous_band_is_decided_by_the_comparison_with_a_new_fruit():
+    """The rebound score (distance over the 99 % point of χ² with four degrees of freedom) is a scale, not a
+    probability: in its ambiguous band above 1 (AMBIGUOUS) it cannot decide alone.  There the comparison with a
+    new fruit of the lane does (2 ln B ≥ STRONG_EVIDENCE, Kass & Raftery 1995): the hidden fruit's own rebound,
+    landing later than predicted (its flight 1.2–1.5 times: a livelier fruit than the lane's typical one, seen on
+    chain7 at seed 1: score 1.22, 10.9 sd from any new fruit, 3.9 sd from the rebound), is that rebound, said to
+    be ambiguous; beyond the band it is a new fruit, said to be ambiguous or not at all."""
+    from fruitimpact.signals.rebounds import judge_unmeasured
+    from fruitimpact.signals.rebounds.pulses import AMBIGUOUS
+    from fruitimpact.signals.rebounds.lane import STRONG_EVIDENCE
+
+    fruit = _lane_fruit()
+    hidden = impact(restitution=0.57)
+    back = impact(velocity=hidden["e"] * V_LINE, c=hidden["c"])
+    left = 1.0 + hidden["T"]
+    flight = 2 * 0.95 * hidden["e"] * V_LINE / G
+    taken = left_out = beyond = 0
+    for late in np.linspace(1.0, 2.0, 101):
+        verdict = judge_unmeasured(summary(back, left + late * flight, 99), 42, 1.0, fruit, V_LINE)
+        ev = verdict.evidence
+        if ev and ev["score"] is not None and 1.0 < ev["score"] <= AMBIGUOUS[1]:
+            margin = ev["new_fruit_distance"] ** 2 - ev["rebound_distance"] ** 2
+            assert verdict.ambiguous and verdict.rebound == (margin >= STRONG_EVIDENCE), (late, ev)
+            taken += verdict.rebound
+            left_out += not verdict.rebound
+        elif not ev or ev["score"] is None or ev["score"] > AMBIGUOUS[1]:  # beyond the band (no evidence kept)
+            beyond += 1
+            assert not verdict.rebound, (late, ev)
+    assert taken >= 3 and beyond >= 3, (taken, left_out, beyond)  # the scan crosses the band: the checks ran
+
 def _fruit_with_rebounds_at(speeds, seed):
     """One fruit of the lot (masses ±10 %) every 0.25 s at each impact speed of ``speeds`` [m/s], each followed by
     its rebound (the same fruit at e V, e its own at that speed) after 2 e V/g × (1 ± 10 %); the signal at 2.2 %

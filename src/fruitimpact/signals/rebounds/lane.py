@@ -361,7 +361,8 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     Each deviation is reported in units of its tolerance (``TOLERANCES["z"]`` sd for the spreads, the flight's
     taken as ``FLIGHT_TOLERANCE_SD`` sd).  Each test alone is loose (the lot's spreads), so the evidence is
     added: the score is the distance in sd, √(Σ d²), over the 99 % point of χ² with four degrees of freedom
-    (score ≤ 1: a rebound), with the ambiguous band of ``judge``.  The tests share r (a wrong r moves the flight,
+    (score ≤ 1: a rebound; in the ambiguous band of ``judge`` above 1, a rebound only by ``STRONG_EVIDENCE`` over
+    a new fruit).  The tests share r (a wrong r moves the flight,
     the impulse and the stiffness together), so that point is a scale chosen on the line recordings of
     tests/linegen.py, not a calibrated probability.  Without the line's speed or enough
     measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
@@ -394,12 +395,14 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
                 "score": round(score, 3) if math.isfinite(score) else None, "threshold": 1.0,
                 "reason": f"contact #{hidden} held a fruit and another pulse landing together and could not be "
                           f"measured; its fruit's rebound, judged from the lane's {len(fruit)} measured fruit"}
-    rebound = score <= 1.0
     ambiguous = AMBIGUOUS[0] < score <= AMBIGUOUS[1]
     # the other explanation: a new fruit of the lane at the line's speed (``_as_lane_rebound``): on the three tests
     # both hypotheses share the rebound must fit clearly better than a new fruit does (``STRONG_EVIDENCE``);
-    # otherwise the contact is a new fruit, said to be ambiguous
+    # otherwise the contact is a new fruit, said to be ambiguous.  In the ambiguous band above 1 the score alone
+    # (a scale, not a probability) cannot decide, and that comparison does: a contact 10.9 sd from any new fruit
+    # of its lane and 3.9 sd from the hidden fruit's rebound (score 1.22) is that rebound, said to be ambiguous
     new_fruit2, rebound2 = shared["new_fruit2"], shared["rebound2"]
+    rebound = score <= 1.0 or (ambiguous and new_fruit2 - rebound2 >= STRONG_EVIDENCE)
     evidence["new_fruit_distance"] = round(math.sqrt(new_fruit2), 3)
     evidence["rebound_distance"] = round(math.sqrt(rebound2), 3) if math.isfinite(rebound2) else None
     if rebound and not new_fruit2 - rebound2 >= STRONG_EVIDENCE:
