@@ -200,7 +200,8 @@ def check_conflicts(given) -> None:
 _MAX_DIGITS = 4000
 
 
-#: Inputs whose range depends on other inputs (alpha on the law, step on the impact): not refused alone.
+#: Inputs whose range depends on other inputs (alpha on the law, step on the impact): a constant within its own
+#: range is not refused for that dependent bound alone (a lot's other fruit may meet it).
 DEPENDENT_INPUTS = ("alpha", "step")
 
 
@@ -208,11 +209,12 @@ def refuse_out_of_range(constants: dict) -> None:
     """Refuse the first constant input (name → a number [SI]; in the table's order of inputs) outside its allowed
     range, with the message a row of the table gets (``range_message``), before anything loads the engine: the
     check a run's one-row evaluation (``evaluation.refuse_constants``) would make first, answered at once (a usage
-    error in ≤ 0.25 s, issue 15 item 4).  ``DEPENDENT_INPUTS`` (a range that depends on other inputs), NaN and
-    what is not a number are left to that evaluation."""
+    error in ≤ 0.25 s, issue 15 item 4).  ``DEPENDENT_INPUTS`` are checked against their own range here (a step
+    of 0 is no step for any fruit); the bound that depends on other inputs, NaN and what is not a number are left
+    to that evaluation."""
     for name, quantity in INPUTS.items():
         value = constants.get(name)
-        if name in DEPENDENT_INPUTS or not isinstance(value, numbers.Real) or is_boolean(value) or math.isnan(value):
+        if not isinstance(value, numbers.Real) or is_boolean(value) or math.isnan(value):
             continue
         if not quantity.allowed.contains(float(value)):
             raise InputError(range_message(quantity), name)
