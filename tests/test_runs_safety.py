@@ -198,6 +198,8 @@ def test_stale_temporaries_of_the_output_are_removed(tmp_path, cli):
     (["sweep", "--velocity", "1:2:3", "-o", "x" * 300 + ".csv"], "argument -o/--output: cannot write"),
     (["sweep", "--velocity", "1:2:3", "--plot", "p.gif"], "argument --plot: cannot write 'p.gif': unsupported format"),
     (["population", "-n", 100, "--scheduler", "not an address"], "argument --scheduler: a scheduler address is like"),
+    # no port: Dask cannot connect (it loaded dask, 0.6 s, and left OUT.parts behind)
+    (["population", "-n", 100, "--scheduler", "notanaddress"], "argument --scheduler: a scheduler address is like"),
     (["population", "-n", 100, "--workdir", "afile/wd"], "argument --workdir"),
     (["population", "-n", "1e20"], "argument -n/--rows: rows must be an integer in [1, 1,000,000,000]; got '1e20'"),
     (["sweep", "--velocity", "0.3:1.5:100000000000", "-o", "x.csv"], "argument --velocity: the COUNT"),
@@ -231,6 +233,27 @@ def test_a_full_disk_is_one_line_and_keeps_the_work_done(tmp_path, cli, monkeypa
     assert "2 chunks resumed" in cli.ok("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
     assert list(pd.read_parquet(tmp_path / "out.parquet")["row"]) == list(range(50))
 
+
+
+def test_a_full_disk_before_any_chunk_leaves_nothing_behind(tmp_path, cli, monkeypatch):
+    """Failing before any chunk was kept (a full disk at the first part, a Dask scheduler that does not answer)
+    leaves nothing to resume: the work folder this run made goes, with its lock, marker and manifest (found by an
+    attack: a refused --scheduler left OUT.parts behind, and the next job to the same output was refused as
+    "a different job").  The files are the run's own; a folder that held the user's files stays (the tests
+    above)."""
+    source = velocities_csv(tmp_path / "in.csv")
+
+    def full(workdir, index, table):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(runs.chunks, "write_part", full)
+    line = cli.error("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
+    assert "No space left on device" in line and "before any chunk was completed" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.csv"]
+    monkeypatch.undo()
+    out = cli.ok("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 10)  # another job: not refused
+    assert "resumed" not in out
+    assert list(pd.read_parquet(tmp_path / "out.parquet")["row"]) == list(range(50))
 
 def test_a_long_run_announces_an_estimate(cli, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)

@@ -204,14 +204,27 @@ def execute(plan, output=None, *, engine=None, workdir=None, fresh: bool = False
         work = WorkDir.open(workdir, plan.fingerprint(), plan.identity(), fresh=fresh, spare=output)
         try:
             summary = _run(plan, work, output, engine, percentiles, keep_columns)
-        except BaseException:
-            work.release()
+        except BaseException as exc:
+            if isinstance(exc, Exception) and not _kept(work):
+                # failed before any chunk was kept (a Dask scheduler that does not answer): nothing to resume, so
+                # the folder's own files go, and the folder if this run made it; an interrupt keeps it as it says
+                work.remove()
+            else:
+                work.release()
             raise
         work.remove()
         return summary
     finally:
         if output_lock is not None:
             output_lock.release(remove=True)
+
+
+def _kept(work: WorkDir) -> bool:
+    """Whether the work folder holds a completed chunk (or a manifest that cannot be read: kept, to be looked at)."""
+    try:
+        return bool(work.records())
+    except Exception:
+        return True
 
 
 def _run(plan, work: WorkDir, output, engine, percentiles, keep_columns) -> RunSummary:
@@ -243,6 +256,9 @@ def _run(plan, work: WorkDir, output, engine, percentiles, keep_columns) -> RunS
                 writer.close()
         except OSError as exc:
             reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            if not records:
+                raise RunError(f"writing failed ({reason}) before any chunk was completed: fix that and run the "
+                               f"same command again") from None
             raise RunError(f"writing failed ({reason}); the {len(records)} completed chunks are kept in "
                            f"{work.path}: fix that and run the same command again to resume") from None
         finally:

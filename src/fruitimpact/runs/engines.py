@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 from fruitimpact.runs.plan import RunError
 
-#: A Dask scheduler address: ``tcp://host:port``, ``host:port`` (no spaces).
-_ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+.-]*://)?[^\s/:]+(?::\d{1,5})?(?:/\S*)?$")
+#: A Dask scheduler address: ``tcp://host:port``, ``host:port`` (no spaces; Dask needs the port).
+_ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+.-]*://)?[^\s/:]+:\d{1,5}(?:/\S*)?$")
 
 
 def check_scheduler(address: str) -> str:
