@@ -680,7 +680,8 @@ def test_a_failure_caused_by_a_swallowed_ctrl_c_is_answered_as_the_interrupt(mon
                                   ["sweep", "--mass", "1,2", "--plot", "figure.bogus"], ["simulate", "--mas", "1"],
                                   ["fit-damage", "no-such-tests.csv"], ["analyze", "no-such-recording.csv"],
                                   ["sphere", "no-such-log.csv", "--criterion", "energy", "--bruise-energy", "0.1J"],
-                                  ["population", "--mass", "0g"], ["sweep", "--restitution", "1.5"]])
+                                  ["population", "--mass", "0g"], ["sweep", "--restitution", "1.5"],
+                                  []])  # no command: one line on stderr (it was the help on stdout, stderr empty)
 def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_numpy(argv, tmp_path):
     """Issue 15 item 4: ``--help`` and a usage error answer at once (0.25 s), so they may not start numba (0.7 s)
     or NumPy (0.15 s).  The console script itself is run, as a subprocess: ``main()`` in process shares the
@@ -695,6 +696,8 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
     done = subprocess.run([console_script(), *argv], capture_output=True, text=True, cwd=tmp_path, env=env,
                           timeout=60)
     assert done.returncode == (0 if "--help" in argv else 2), done.stderr[-2000:]
+    said = [line for line in done.stderr.splitlines() if not line.startswith("import time:")]
+    assert "--help" in argv or (len(said) == 1 and ": error: " in said[0] and done.stdout == ""), said
     imported = {line.rsplit("|", 1)[-1].strip() for line in done.stderr.splitlines() if line.startswith("import time:")}
     assert "fruitimpact.cli" in imported  # the log is there: the check below can fail
     assert not {name for name in imported if name.split(".")[0] in ("numba", "numpy")}, argv
