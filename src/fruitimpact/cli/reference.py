@@ -17,10 +17,11 @@ def _checked(check, *args):
 
 def cmd_paper(args) -> int:
     from fruitimpact.impact.outputs import check_output_folder
-    from fruitimpact.reference.paper import format_paper_report, paper_report
 
     if args.figures:
         _checked(check_output_folder, args.figures, "--figures")
+    from fruitimpact.reference.paper import format_paper_report, paper_report  # the engine: once the options hold
+
     report = paper_report()
     if args.figures:
         from fruitimpact.reference.paper import write_paper_figures
@@ -35,8 +36,6 @@ def cmd_paper(args) -> int:
 
 
 def cmd_models(args) -> int:
-    from fruitimpact.reference.comparison import format_restitution_table, restitution_table
-    from fruitimpact.plotting import restitution_figure
     from fruitimpact.physics import DAMPING_LAWS
 
     for name in args.model or ():
@@ -50,11 +49,14 @@ def cmd_models(args) -> int:
         _checked(check_output, args.csv, "--csv", CSV_FORMAT)
     if args.plot:
         _checked(check_output, args.plot, "--plot", FIGURE_FORMATS)
+    # the engine and matplotlib only once every option holds (a usage error in 0.25 s, issue 15 item 4)
+    from fruitimpact.reference.comparison import format_restitution_table, restitution_table
+
     table = restitution_table(args.model, targets, velocities)
     if args.csv:
         _library_call(atomic_write, args.csv, lambda tmp: table.to_csv(tmp, index=False), "--csv")
     if args.plot:
-        from fruitimpact.plotting import save_figure
+        from fruitimpact.plotting import restitution_figure, save_figure
 
         _library_call(save_figure, restitution_figure(table), args.plot, "--plot")
     if args.json:

@@ -38,6 +38,9 @@ from fruitimpact.physics.constants import STANDARD_GRAVITY
 
 #: Impacts followed at most.
 MAX_IMPACTS = 50
+#: The refusal of a drop onto a free partner.
+FREE_PARTNER = ("a drop bounces on a fixed surface, not a free partner (surface fruit, partner_mass): simulate the "
+                "fruit-on-fruit impact itself with --surface fruit")
 #: The fruit is at rest once a rebound would rise less than this [m].
 REST_HEIGHT = 1e-3
 #: Accumulation rule, named in every output.
@@ -123,6 +126,9 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     rest_height = check_number("rest_height", rest_height, low=0.0, low_inclusive=False, high=1.0,
                                high_inclusive=True)
     max_impacts = read_count("max_impacts", max_impacts, 1, 1000)
+    if inputs.get("partner_mass") is not None or inputs.get("surface") == "fruit" \
+            or inputs.get("surface_model") == "fruit":  # said at once; a partner resolved otherwise, below
+        raise InputError(FREE_PARTNER, "surface")
     # the engine only now: every argument above is answered without it
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
@@ -134,8 +140,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     if first.status[0] == 3:  # invalid: the one-line refusal, naming the argument
         raise InputError(messages.text(0), messages.argument(0))
     if math.isfinite(first.columns["partner_mass"][0]):  # as resolved: surface "fruit" (any spelling), partner_mass
-        raise InputError("a drop bounces on a fixed surface, not a free partner (surface fruit, partner_mass): "
-                         "simulate the fruit-on-fruit impact itself with --surface fruit", "surface")
+        raise InputError(FREE_PARTNER, "surface")
     height = float(first.columns["drop_height"][0])
     criterion = first.columns["criterion"][0]
     impacts = []

@@ -237,17 +237,9 @@ def audit(points: list[TransferPoint], members: dict, rows: int, criterion: str,
     with that one change and what it saves (the same fruit, so the saving is paired, not a sampling
     difference); ``point_incidence`` is the point's own incidence with the change."""
     from fruitimpact.impact.validation import InputError
-    from fruitimpact.library.catalogue import surfaces
     from fruitimpact.physics.constants import STANDARD_GRAVITY
 
-    if isinstance(alternatives, str) or not all(isinstance(a, (str, Pad)) for a in alternatives):
-        raise InputError("alternatives must be a sequence of library surface names (or Pad)", "alternatives")
-    cushions = [name for name, entry in surfaces().items() if entry.partner is None]
-    unknown = [a for a in alternatives if isinstance(a, str) and a not in cushions]
-    if unknown:
-        raise InputError(f"alternatives must be library surfaces ({', '.join(cushions)}); got {unknown[0]!r}",
-                         "alternatives")
-    alternatives = tuple(dict.fromkeys(alternatives))  # each once, in the order given
+    alternatives = checked_alternatives(alternatives)
     from fruitimpact.impact.evaluation import evaluation  # the engine only now: the arguments are answered without it
     bruised_any = np.zeros(rows, dtype=bool)
     volume_total = np.zeros(rows)
@@ -380,6 +372,22 @@ MAX_LINE_FRUIT = 10_000_000
 LINE_FRUIT = 10_000
 
 
+def checked_alternatives(alternatives) -> tuple:
+    """The surfaces a line audit tries in place of each point's own: library surfaces that are no free partner,
+    or :class:`Pad`; each once, in the order given.  ``InputError`` naming ``alternatives`` otherwise."""
+    from fruitimpact.impact.validation import InputError
+    from fruitimpact.library.catalogue import surfaces
+
+    if isinstance(alternatives, str) or not all(isinstance(a, (str, Pad)) for a in alternatives):
+        raise InputError("alternatives must be a sequence of library surface names (or Pad)", "alternatives")
+    cushions = [name for name, entry in surfaces().items() if entry.partner is None]
+    unknown = [a for a in alternatives if isinstance(a, str) and a not in cushions]
+    if unknown:
+        raise InputError(f"alternatives must be library surfaces ({', '.join(cushions)}); got {unknown[0]!r}",
+                         "alternatives")
+    return tuple(dict.fromkeys(alternatives))
+
+
 def audit_line(line, *, rows: int = LINE_FRUIT, seed: int = 0, criterion: str | None = None,
                alternatives=DEFAULT_ALTERNATIVES, spreads: bool = True, **inputs) -> dict:
     """Audit a handling line: pass a lot of ``rows`` fruit through its transfer points and count the bruises.
@@ -449,6 +457,7 @@ def audit_line(line, *, rows: int = LINE_FRUIT, seed: int = 0, criterion: str | 
             tuple(a.strip() for a in alternatives.split(","))
         if any(not a for a in alternatives):
             raise InputError("alternatives must be library surface names, comma-separated, or none", "alternatives")
+    alternatives = checked_alternatives(alternatives)
     # every input checked (with the criterion) before the lot is drawn; each point sets its height and surface
     source, constants, described = read_lot(inputs, rows=rows, seed=seed, spreads=spreads, criterion=criterion,
                                             excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),

@@ -291,6 +291,27 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
     bottoming = np.where(crushing, crush * math.pi * radius / layer_stiffness, thickness) \
         if crushing.any() else thickness
 
+    # rk4's refusals need only the impact's scales: made before the laws' calibration (compiled), so that a
+    # refused step is a usage error answered without the engine
+    step = used["step"]
+    rk4 = np.zeros(rows, dtype=bool)
+    for code, method in enumerate(uniques["method"]):
+        if method == "rk4":
+            rk4 |= codes["method"] == code
+    if rk4.any() and plastic.any():
+        messages.set(rk4 & plastic & ~messages.flagged,
+                     "method rk4 integrates the paper's elastic laws only: plastic contact and cushion layers are "
+                     "computed exactly (method accurate)", "method")
+    if rk4.any():
+        limit = max_rk4_step(mass, stiffness, velocity)
+        too_coarse = rk4 & ~messages.flagged & ~(step <= limit)
+        if too_coarse.any():
+            text = "step must be at most 1/20 of the contact duration for rk4 (at least 20 steps per contact)"
+            if detail:
+                text = (f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
+                        f"{20} steps per contact); got {float(step[0])!r}")
+            messages.set(too_coarse, text, "step")
+
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
     model_codes = codes["model"]
@@ -361,25 +382,6 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                 messages.set(_mask(below, rows), f"restitution must be >= {TABLE_E_MIN:g} for model {model} with "
                                                  f"calibration exact (its table of e against the damping stops "
                                                  f"there)", "restitution")
-
-    step = used["step"]
-    rk4 = np.zeros(rows, dtype=bool)
-    for code, method in enumerate(uniques["method"]):
-        if method == "rk4":
-            rk4 |= codes["method"] == code
-    if rk4.any() and plastic.any():
-        messages.set(rk4 & plastic & ~messages.flagged,
-                     "method rk4 integrates the paper's elastic laws only: plastic contact and cushion layers are "
-                     "computed exactly (method accurate)", "method")
-    if rk4.any():
-        limit = max_rk4_step(mass, stiffness, velocity)
-        too_coarse = rk4 & ~messages.flagged & ~(step <= limit)
-        if too_coarse.any():
-            text = "step must be at most 1/20 of the contact duration for rk4 (at least 20 steps per contact)"
-            if detail:
-                text = (f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
-                        f"{20} steps per contact); got {float(step[0])!r}")
-            messages.set(too_coarse, text, "step")
 
     status = np.full(rows, INVALID, dtype=np.int8)
     out = None

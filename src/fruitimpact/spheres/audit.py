@@ -149,7 +149,7 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     from fruitimpact.impact.units import parse_quantity
     from fruitimpact.impact.validation import InputError, check_flag, check_number, read_count
     from fruitimpact.library.catalogue import surfaces
-    from fruitimpact.spheres.calibration import read_calibration
+    from fruitimpact.spheres.calibration import read_calibration, read_calibration_table
     from fruitimpact.spheres.devices import build_sphere
     from fruitimpact.spheres.inversion import DEFAULT_UNCERTAINTY, Z95, invert
     from fruitimpact.spheres.log import read_log
@@ -209,14 +209,24 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     except ValueError as exc:
         raise InputError(f"log: {exc}" if not str(exc).startswith("columns") else str(exc),
                          "columns" if str(exc).startswith("columns") else "log") from None
+    # the sphere and its calibration file before the lot too (the calibration's fit comes after it)
+    calibration = table = None
+    if sphere_calibration is not None:
+        # a modulus given beside a calibration is refused here ("not both"), as after the fit
+        probe = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson,
+                             calibrated_modulus=1.0)
+        try:
+            table = read_calibration_table(sphere_calibration)
+        except ValueError as exc:
+            raise InputError(str(exc), "sphere_calibration") from None
+    else:
+        body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson)
     read_lot(inputs, rows=1, seed=seed, spreads=spreads, criterion=criterion,
              excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
              excluded_reason="is set by each transfer point the sphere measured")
-    calibration = None
     if sphere_calibration is not None:
-        probe = build_sphere(device=sphere, mass=mass, diameter=diameter, calibrated_modulus=1.0)
         try:
-            calibration = read_calibration(sphere_calibration, probe.mass, probe.diameter)
+            calibration = read_calibration(sphere_calibration, probe.mass, probe.diameter, table=table)
         except ValueError as exc:
             raise InputError(str(exc), "sphere_calibration") from None
         # the fit's 95 % interval of its mean, as a relative standard uncertainty (one drop: its scatter unknown)
@@ -225,8 +235,6 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson,
                             calibrated_modulus=calibration["contact_modulus"],
                             calibration_source=f"calibration {sphere_calibration}", calibrated_sd=half / 1.96)
-    else:
-        body = build_sphere(device=sphere, mass=mass, diameter=diameter, modulus=modulus, poisson=poisson)
     untimed = int(np.count_nonzero(np.isnan(readings.duration)))
     if untimed and restitution is None:
         raise InputError(f"sphere_restitution is needed: {untimed} of {len(readings)} readings have no duration, and "

@@ -137,10 +137,11 @@ def calibrate(sphere_mass: float, sphere_diameter: float, drop_height, peak_acce
             "message": message, "warnings": warnings}
 
 
-def read_calibration(path, sphere_mass: float, sphere_diameter: float, columns=None) -> dict:
-    """Read a calibration file (``drop_height`` [m], ``peak_acceleration`` [g], ``velocity_change`` [m/s],
-    optionally ``duration`` [s]) and ``calibrate``; ``ValueError`` naming ``sphere_calibration``, the row and
-    the column of a problem (a calibration is small and must be whole: a bad row refuses it)."""
+def read_calibration_table(path, columns=None) -> tuple[dict, np.ndarray]:
+    """The readings of a calibration file (``drop_height`` [m], ``peak_acceleration`` [g], ``velocity_change``
+    [m/s], optionally ``duration`` [s]) and their file line numbers; ``ValueError`` naming ``sphere_calibration``,
+    the row and the column of a problem (a calibration is small and must be whole: a bad row refuses it).  No
+    compiled code: a usage error is answered at once."""
     from fruitimpact.spheres.log import parse_columns
 
     mapping = parse_columns(columns, tuple(CALIBRATION_COLUMNS)) if columns else {}
@@ -150,10 +151,17 @@ def read_calibration(path, sphere_mass: float, sphere_diameter: float, columns=N
         raise ValueError(f"sphere_calibration: {exc}") from None
     if not good.all():
         raise ValueError(f"sphere_calibration: {path}, {_skipped_text(skipped)}")
+    return values, numbers
+
+
+def read_calibration(path, sphere_mass: float, sphere_diameter: float, columns=None, table=None) -> dict:
+    """``calibrate`` on a calibration file's readings (``read_calibration_table``, or ``table`` as it returned
+    them); ``ValueError`` as that function raises it."""
+    values, numbers = table if table is not None else read_calibration_table(path, columns)
     report = calibrate(sphere_mass, sphere_diameter, values["drop_height"], values["peak_acceleration"],
                        values["velocity_change"], values["duration"], numbers)
     report["file"] = str(path)
     return report
 
 
-__all__ = ["CALIBRATION_COLUMNS", "calibrate", "read_calibration"]
+__all__ = ["CALIBRATION_COLUMNS", "calibrate", "read_calibration", "read_calibration_table"]
