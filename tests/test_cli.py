@@ -684,7 +684,9 @@ def test_a_failure_caused_by_a_swallowed_ctrl_c_is_answered_as_the_interrupt(mon
                                   [],  # no command: one line on stderr (it was the help on stdout, stderr empty)
                                   # found by an attack, each 0.7 s with numba before: options of models and paper
                                   ["models", "--targets", "0"], ["models", "--plot", "out.gif"],
-                                  ["paper", "--figures", "/proc/x"]])
+                                  ["paper", "--figures", "/proc/x"],
+                                  # a detector option the file's rate refuses (1.2 s with numba before)
+                                  ["stream", "--rate", "20kHz", "--sort-by", "nosuch", "--thresholds", "1"]])
 def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_numpy(argv, tmp_path):
     """Issue 15 item 4: ``--help`` and a usage error answer at once (0.25 s), so they may not start numba (0.7 s)
     or NumPy (0.15 s).  The console script itself is run, as a subprocess: ``main()`` in process shares the
@@ -723,7 +725,8 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
     (["sphere", "LOG", "--sphere-mass", "0g", "--sphere-diameter", "89mm", "--sphere-modulus", "40MPa",
       "--sphere-poisson", "0.45"], "argument --sphere-mass: sphere_mass must be a finite number >= 0.001"),
     (["sphere", "LOG", "--sphere", "is-1987", "--sphere-calibration", "missing.csv"],
-     "argument --sphere-calibration: cannot read missing.csv")])
+     "argument --sphere-calibration: cannot read missing.csv"),
+    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500]")])
 def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tmp_path):
     """Issue 15 item 4: a refusal found by validating the inputs (a criterion whose input the fruit lacks, a law
     that cannot carry plastic contact, a drop onto a free partner, an rk4 step too coarse for the impact, an
@@ -740,7 +743,8 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     examples = Path(__file__).parents[1] / "examples"
     shutil.copy(examples / "line.csv", tmp_path / "line.csv")
     shutil.copy(examples / "sphere-log.csv", tmp_path / "sphere-log.csv")
-    files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv")}
+    (tmp_path / "rec.csv").write_text("time [s],force [N]\n" + "".join(f"{k / 1000:.3f},0.0\n" for k in range(100)))
+    files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv"), "REC": str(tmp_path / "rec.csv")}
     argv = [files.get(a, a) for a in argv]
     env = {**os.environ, "PYTHONPROFILEIMPORTTIME": "1"}
     done = subprocess.run([console_script(), *argv], capture_output=True, text=True, cwd=tmp_path, env=env,

@@ -130,11 +130,11 @@ def cmd_analyze(args) -> int:
         raise UsageError(_reading_error(exc, args)) from None
     for note in source.notes:
         print(f"{PROG} analyze: warning: {args.file}: {note}", file=sys.stderr, flush=True)
-    from fruitimpact.signals import offline  # the detector and the fit (numba) once the file opened
+    settings, analysis = analysis_from(args, source.rate)  # the options against the file's own rate
+    from fruitimpact.signals import offline  # the detector and the fit (numba) once the file opened and the options hold
     from fruitimpact.signals.analysis import public
     from fruitimpact.signals.stream import StreamAnalyzer
 
-    settings, analysis = analysis_from(args, source.rate)
     keep = bool(args.plot)  # a figure of the recording needs its samples and windows
     impacts, reports = [], []
 

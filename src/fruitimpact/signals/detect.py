@@ -79,7 +79,7 @@ import numpy as np
 from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.filters import butterworth_sos, solve_small
-from fruitimpact.signals.settings import DetectorSettings, check_rate
+from fruitimpact.signals.settings import DetectorSettings, at_rate, check_rate
 
 __all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
 
@@ -538,14 +538,6 @@ def _flush(F, I, R, IP, OF, OI, OW, cnt):
 # The Python front end
 
 
-def _samples(name: str, seconds: float, rate: float, minimum: int) -> int:
-    count = round(seconds * rate)
-    if count < minimum:
-        raise ValueError(f"{name} must be at least {minimum} sample{'s' if minimum > 1 else ''} "
-                         f"(>= {minimum / rate:g} s at {rate:g} Hz); got {seconds!r} s")
-    return count
-
-
 class Detector:
     """Causal impact detector over ``lanes`` force lanes sampled at ``rate`` [Hz] (module docstring).
 
@@ -567,26 +559,10 @@ class Detector:
         rate = float(rate)
         s = settings
         self.rate, self.settings, self.lanes = rate, s, int(lanes)
-        hold = _samples("offset_hold", s.offset_hold, rate, 1)
-        min_len = _samples("min_duration", s.min_duration, rate, 1)
-        max_len = _samples("max_duration", s.max_duration, rate, 1)
-        if max_len <= min_len:
-            raise ValueError(f"max_duration must be longer than min_duration = {s.min_duration:g} s "
-                             f"in samples at {rate:g} Hz; got {s.max_duration!r} s")
-        pre = _samples("pre_trigger", s.pre_trigger, rate, 0)
-        post = _samples("post_trigger", s.post_trigger, rate, 0)
-        warm_n = _samples("warmup", s.warmup, rate, 16)
+        windows = at_rate(s, rate)  # every check against the rate (settings.at_rate)
+        hold, min_len, max_len = windows["offset_hold"], windows["min_duration"], windows["max_duration"]
+        pre, post, warm_n, gain = windows["pre_trigger"], windows["post_trigger"], windows["warmup"], windows["hum_gain"]
         harm = np.array(s.hum_harmonics if s.hum_frequency is not None else (), dtype=np.int64)
-        gain = 0.0
-        if s.hum_frequency is not None:
-            top = s.hum_frequency * harm[-1]
-            if not top < rate / 2:
-                raise ValueError(f"hum_frequency × the highest harmonic must be below rate/2 = {rate / 2:g} Hz; "
-                                 f"got {s.hum_frequency:g} Hz × {harm[-1]}")
-            gain = 2 * math.pi * s.hum_frequency / (s.hum_q * rate)
-            if not gain < 0.5:
-                raise ValueError(f"hum_q must be > {4 * math.pi * s.hum_frequency / rate:g} at {rate:g} Hz "
-                                 f"(a notch narrower than a quarter of the sample rate); got {s.hum_q!r}")
         sos = (butterworth_sos(s.lowpass_cutoff, s.lowpass_order, rate) if s.lowpass_cutoff is not None
                else np.zeros((0, 6)))
         fifo = post // (min_len + hold) + 4

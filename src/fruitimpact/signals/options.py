@@ -86,7 +86,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
                for name, value in options.items()}
     args = _Options({**ANALYSIS_DEFAULTS, **{k: v for k, v in options.items() if v is not None}})
     from fruitimpact.physics.constants import STANDARD_GRAVITY
-    from fruitimpact.signals.settings import DetectorSettings
+    from fruitimpact.signals.settings import DetectorSettings, at_rate
 
     # every plain check first: a usage error is answered before the detector and the fit (numba) are imported
     hum = _number("--hum", args.hum, "frequency")
@@ -114,9 +114,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
         settings = DetectorSettings(k_on=k_on, k_off=k_off, hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,),
                                     lowpass_cutoff=lowpass, clip_low=clip[0], clip_high=clip[1])
         if rate_known:
-            from fruitimpact.signals.detect import Detector
-
-            Detector(rate, settings)  # the checks against the rate (hum harmonics below rate/2, …)
+            at_rate(settings, rate)  # the checks against the rate (hum harmonics below rate/2, …), without numba
     except ValueError as exc:
         raise _setting_error(exc) from None
     classes = None

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 #: Most lanes (force channels) of one recording or stream: analyze, stream and the web app's pages.
 MAX_LANES = 256
 
-__all__ = ["MAX_LANES", "Analysis", "DetectorSettings"]
+__all__ = ["MAX_LANES", "Analysis", "DetectorSettings", "at_rate", "in_samples"]
 
 
 @dataclass(frozen=True)
@@ -140,6 +140,45 @@ def check_rate(rate, argument: str = "rate") -> float | None:
     if not math.isfinite(rate) or not 0.0 < rate <= MAX_RATE:
         raise InputError(f"{argument} must be a finite number of Hz in (0, {MAX_RATE:.0e}]; got {rate!r}", argument)
     return rate
+
+
+def in_samples(name: str, seconds: float, rate: float, minimum: int) -> int:
+    """``seconds`` [s] as a whole number of samples at ``rate`` [Hz], at least ``minimum``; ValueError otherwise."""
+    count = round(seconds * rate)
+    if count < minimum:
+        raise ValueError(f"{name} must be at least {minimum} sample{'s' if minimum > 1 else ''} "
+                         f"(>= {minimum / rate:g} s at {rate:g} Hz); got {seconds!r} s")
+    return count
+
+
+def at_rate(settings: DetectorSettings, rate: float) -> dict:
+    """The detector's windows in samples at ``rate`` [Hz] (``offset_hold``, ``min_duration``, ``max_duration``,
+    ``pre_trigger``, ``post_trigger``, ``warmup``) and its hum notch's gain, each checked against the rate: a
+    window under its least samples, a hum harmonic at or above rate/2, a notch narrower than a quarter of the
+    rate, a low-pass cutoff at or above rate/2.  ValueError (one line) otherwise.  Plain Python, so that an option
+    the rate refuses is a usage error answered before the detector (numba) is loaded."""
+    s = settings
+    out = {"offset_hold": in_samples("offset_hold", s.offset_hold, rate, 1),
+           "min_duration": in_samples("min_duration", s.min_duration, rate, 1),
+           "max_duration": in_samples("max_duration", s.max_duration, rate, 1)}
+    if out["max_duration"] <= out["min_duration"]:
+        raise ValueError(f"max_duration must be longer than min_duration = {s.min_duration:g} s "
+                         f"in samples at {rate:g} Hz; got {s.max_duration!r} s")
+    out.update(pre_trigger=in_samples("pre_trigger", s.pre_trigger, rate, 0),
+               post_trigger=in_samples("post_trigger", s.post_trigger, rate, 0),
+               warmup=in_samples("warmup", s.warmup, rate, 16), hum_gain=0.0)
+    if s.hum_frequency is not None:
+        top = s.hum_frequency * s.hum_harmonics[-1]
+        if not top < rate / 2:
+            raise ValueError(f"hum_frequency × the highest harmonic must be below rate/2 = {rate / 2:g} Hz; "
+                             f"got {s.hum_frequency:g} Hz × {s.hum_harmonics[-1]}")
+        out["hum_gain"] = 2 * math.pi * s.hum_frequency / (s.hum_q * rate)
+        if not out["hum_gain"] < 0.5:
+            raise ValueError(f"hum_q must be > {4 * math.pi * s.hum_frequency / rate:g} at {rate:g} Hz "
+                             f"(a notch narrower than a quarter of the sample rate); got {s.hum_q!r}")
+    if s.lowpass_cutoff is not None and not 0 < s.lowpass_cutoff < rate / 2:
+        raise ValueError(f"lowpass_cutoff must be in (0, rate/2) = (0, {rate / 2:g}) Hz; got {s.lowpass_cutoff!r}")
+    return out
 
 
 #: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).
