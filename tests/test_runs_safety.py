@@ -342,6 +342,9 @@ def test_a_cell_that_is_not_utf8_or_a_column_of_another_type_is_a_bad_row_not_a_
     (["line", "dup.csv", "-n", "10", "--fruit", "apple"], "transfer point 'a' is named twice"),
     # a constant that refuses every row (found by an attack: each ran and printed "0 ok, 10 invalid", exit 0)
     (["population", "-n", "10", "--step", "0"], "argument --step: step must be a finite number > 0 s"),
+    # a work folder in a folder that does not exist: the chain of folders above it was made and left behind
+    (["population", "-n", "10", "-o", "p.csv", "--workdir", "no/such/parts"],
+     "argument --workdir: cannot write 'no/such/parts': folder 'no/such' does not exist"),
     (["population", "-n", "10", "--model", "kelvin-voigt", "--alpha", "0.3"],
      "argument --alpha: alpha is Hunt–Crossley's damping parameter of the power-law laws"),
     (["sweep", "--velocity", "0.5:1:3", "-o", "a.csv", "--step", "0"], "argument --step: step must be"),

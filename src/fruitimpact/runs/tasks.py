@@ -59,9 +59,9 @@ def check_run(plan, output=None, *, engine=None, scheduler=None, workers=None, w
     folder = Path(workdir) if workdir else runs.default_workdir(output, plan)
     if output is not None and folder.resolve() == Path(output).resolve():
         raise InputError(f"workdir: cannot use {str(folder)!r}: it is the output file's own name", "workdir")
-    existing = folder
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
+    # the folder itself may be made (and is removed with the parts), never the folders above it: a run removes
+    # only what it made, and a chain of new folders would stay behind (as an output in a missing folder is refused)
+    existing = folder if folder.exists() else folder.parent
     try:
         if existing.exists() and not existing.is_dir():
             raise ValueError(f"workdir: cannot use {str(folder)!r}: {str(existing)!r} is not a folder")

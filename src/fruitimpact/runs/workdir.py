@@ -189,7 +189,7 @@ class WorkDir:
         path = Path(path).resolve()
         if not path.exists():
             try:
-                path.mkdir(parents=True)
+                path.mkdir()  # its own folder only: a run removes what it made, never folders above
             except FileExistsError:
                 pass  # another run was faster: treated as an existing folder below
             except OSError as exc:
