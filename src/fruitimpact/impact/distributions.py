@@ -231,8 +231,6 @@ class Sample:
 
 def _read_sample(argument: str, dimension: str, default_column: str | None) -> Sample:
     """``FILE[:COLUMN]`` → Sample; the column defaults to ``default_column`` or the file's only column."""
-    import pandas as pd
-
     path, column = argument, None
     if not Path(path).exists() and ":" in argument:
         path, column = argument.rsplit(":", 1)
@@ -241,6 +239,8 @@ def _read_sample(argument: str, dimension: str, default_column: str | None) -> S
     suffix = Path(path).suffix.lower()
     if suffix not in (".csv", ".parquet", ".pq"):
         raise ValueError(f"sample: {path!r} must be .csv or .parquet")
+    import pandas as pd  # (0.3 s) once the file is there
+
     try:
         frame = pd.read_parquet(path) if suffix != ".csv" else pd.read_csv(path)
     except (ValueError, OSError, UnicodeDecodeError) as exc:  # a ragged row, not UTF-8, not Parquet: one line

@@ -227,7 +227,8 @@ def evaluate_inputs(inputs: InputColumns, messages: MessageBook, *, tabulated: b
         return _evaluate(inputs, messages, tabulated, detail, closed_forms)
 
 
-def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, closed_forms) -> Evaluation:
+def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, closed_forms,
+              validate_only: bool = False) -> Evaluation | MessageBook:
     rows = inputs.rows
     values, given = inputs.values, inputs.given
     given_any = {name: bool(given[name].any()) for name in ("alpha", "damping")}
@@ -369,7 +370,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
         for cal_code, calibration in enumerate(uniques["calibration"]):
             sub = calibrate if len(uniques["calibration"]) == 1 else calibrate & (calibrations == cal_code)
             rows_sub, sub_sel = _selection(sub, idx, sel)
-            if rows_sub.size == 0:
+            if rows_sub.size == 0 or validate_only:
                 continue
             # the compiled engine is loaded where a row is computed, not to validate one (a usage error in 0.25 s)
             from fruitimpact.physics.calibrate import TABLE_E_MIN
@@ -383,6 +384,8 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                                  f"calibration exact (its table of e against the damping stops "
                                                  f"there)", "restitution")
 
+    if validate_only:  # every refusal the inputs alone decide (the exact calibration's table limit aside)
+        return messages
     status = np.full(rows, INVALID, dtype=np.int8)
     out = None
     plastic_block = None
@@ -696,18 +699,23 @@ def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluati
 def refuse_constants(constants: dict, text: dict, given=()) -> None:
     """Refuse, before a run of many rows, a constant input out of its range or an input that the constants need
     and nobody gave (the energy criterion's threshold, a failure stress the fruit lacks): it would refuse every
-    row.  One row of ``constants`` and ``text`` goes through :func:`evaluation`; ``given`` names every input the
-    rows will have (drawn or swept ones too).  ``InputError`` with that row's message."""
+    row.  One row of ``constants`` and ``text`` is validated as :func:`evaluation` validates a row (not computed:
+    the exact calibration's table limit is left to the rows); ``given`` names every input the rows will have
+    (drawn or swept ones too).  ``InputError`` with that row's message."""
     if not constants and not text:
         return
-    probe = evaluation({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
-    message = probe.messages.text(0)
+    # the row validated, not computed: no compiled engine, so that a refusal after it (a missing output, another
+    # job's parts) is answered at once too
+    inputs, messages = read_columns({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        messages = _evaluate(inputs, messages, None, False, False, validate_only=True)
+    message = messages.text(0)
     # the input a refusal names (its argument), else its first word: "plastic contact (--yield-pressure ...)"
     # is about yield_pressure
-    name = probe.messages.argument(0) or message.split(" ", 1)[0]
+    name = messages.argument(0) or message.split(" ", 1)[0]
     # a dependent bound ("step must be at most 1/20 of the contact duration") may hold for the lot's other fruit;
     # any other refusal of such an input (alpha with a law that has none) holds for every row
-    if probe.status[0] != INVALID or (name in DEPENDENT_INPUTS and message.startswith(f"{name} must be")):
+    if not messages.flagged[0] or (name in DEPENDENT_INPUTS and message.startswith(f"{name} must be")):
         return
     if name in set(constants) | set(text) or (name in INPUTS and name not in set(given)):
         raise InputError(message, name)
