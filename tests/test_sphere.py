@@ -164,6 +164,32 @@ def test_a_point_incidence_equals_line_on_the_same_drop_and_surface(clean, tmp_p
                                        surface_modulus=p["surface_modulus"], surface_poisson=0.3) for p in measured],
                         rows=400, fruit="apple")
     assert [p["incidence"] for p in report["points"]] == [p["incidence"] for p in measured]
+    # and by the command: the line file's measured-surface columns (the sphere's reading, ν = 0.3)
+    line.write_text("name,drop_height,surface,surface_modulus,surface_poisson\n" + "".join(
+        f"{p['name']},{p['drop_height']!r},{p['surface']},{p['surface_modulus']!r},0.3\n" for p in measured))
+    result = json.loads(run("line", line, "--fruit", "apple", "-n", 400, "--json").stdout)
+    assert [p["incidence"] for p in result["points"]] == [p["incidence"] for p in measured]
+
+
+def test_the_json_of_a_sphere_audit_holds_the_contract(tmp_path):
+    """Issue 18 item 3 (a contract checked outside the project): ``sphere --json`` prints one object with
+    ``impacts`` (per reading), ``points`` (per transfer point, a rigid surface's modulus null) and
+    ``worst_point``, under these names."""
+    log = write_log(tmp_path / "log.csv")
+    out = json.loads(run("sphere", log, "--sphere", "is-1987", "--sphere-modulus", "37.5MPa", "--sphere-poisson",
+                         "0.5", "--fruit", "apple", "-n", 200, "--json").stdout)
+    assert {"impacts", "points", "worst_point"} <= set(out)
+    assert len(out["impacts"]) == 3 * len(POINTS)
+    for impact in out["impacts"]:
+        assert {"time", "point", "velocity", "drop_height", "restitution", "surface_modulus", "status",
+                "message"} <= set(impact), impact
+    assert [p["name"] for p in out["points"]] == [name for name, *_ in POINTS]
+    for point in out["points"]:
+        assert {"name", "passes", "impacts", "drop_height", "drop_height_max", "surface_modulus", "surface",
+                "incidence", "bruise_volume", "cushion"} <= set(point), point
+    rigid = {name for name, _, modulus, _ in POINTS if modulus == math.inf}
+    assert all((p["surface_modulus"] is None) == (p["name"] in rigid) for p in out["points"])
+    assert out["worst_point"] in {p["name"] for p in out["points"]}
 
 
 def test_twenty_g_on_padding_bruises_no_apple(tmp_path):
@@ -460,3 +486,30 @@ def test_a_pulse_that_is_not_a_hertz_impact_is_said_so(tmp_path):
     assert "shape" not in steel["message"] and "shape" not in rubber["message"]
     assert steel["drop_height"] == pytest.approx(0.10, rel=0.05) and rubber["drop_height"] == pytest.approx(0.10, rel=0.1)
     assert any("not shaped as a Hunt-Crossley impact" in w for w in report["warnings"])
+
+
+def test_the_charts_incidence_lines_are_where_the_lot_bruises_at_that_fraction(tmp_path):
+    """Item 5: the chart sphere users know (peak g against ΔV) carries the lines at which 10 % and 50 % of *this*
+    lot bruise, surface by surface (``spheres.chart``).  Each line point is a drop height on a surface: the line
+    audit of the same lot from that height onto that surface must bruise that fraction.  Tolerances: the height
+    is interpolated in ln h between grid heights 1.33 times apart, where incidence is not linear in ln h; with 400
+    fruit a share is known to ±2.5 points at 50 % (binomial sd), so ±4 points at 10 % and ±8 at 50 %.  And the
+    physics of the chart: a softer surface needs a larger ΔV for the same damage (the vendor's line slopes so)."""
+    from fruitimpact.handling.line import TransferPoint, audit_line
+    from fruitimpact.spheres.audit import sphere_audit
+
+    log = write_log(tmp_path / "log.csv")
+    report = sphere_audit(log, sphere="is-1987", sphere_modulus="37.5MPa", sphere_poisson=0.5, rows=400,
+                          fruit="apple", chart=True)
+    lines = report["chart"]["fractions"]
+    assert set(lines) == {"0.1", "0.5"} and all(len(line) >= 5 for line in lines.values())
+    for fraction, tolerance in ((0.1, 0.04), (0.5, 0.08)):
+        line = lines[str(fraction)]
+        for point in (line[0], line[len(line) // 2], line[-1]):  # a soft surface, a middle one, the stiffest
+            modulus = point["surface_modulus"]
+            at = TransferPoint("here", point["drop_height"], "steel", surface_modulus=modulus,
+                               surface_poisson=None if modulus is None else 0.3)
+            found = audit_line([at], rows=400, fruit="apple", alternatives=())["points"][0]["incidence"]
+            assert found == pytest.approx(fraction, abs=tolerance), (fraction, point, found)
+        changes = [p["velocity_change"] for p in line]
+        assert all(a >= b for a, b in zip(changes, changes[1:])), changes  # softer first: larger ΔV
