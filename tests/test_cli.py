@@ -729,7 +729,8 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
     (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500]"),
     # a refusal after the lot's constants are validated (they are no longer computed): 0.7 s before
     (["sweep", "--velocity", "0.5:1:3", "--step", "1e-5"], "argument -o/--output: give -o OUT and/or --plot FILE"),
-    (["population", "--mass", "sample(missing.csv)"], "argument --mass: sample: no such file 'missing.csv'")])
+    (["population", "--mass", "sample(missing.csv)"], "argument --mass: sample: no such file 'missing.csv'"),
+    (["population", "--mass", "sample(fruit.csv:nosuch)"], "argument --mass: sample: 'fruit.csv' has no column 'nosuch'")])
 def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tmp_path):
     """Issue 15 item 4: a refusal found by validating the inputs (a criterion whose input the fruit lacks, a law
     that cannot carry plastic contact, a drop onto a free partner, an rk4 step too coarse for the impact, an
@@ -746,6 +747,7 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     examples = Path(__file__).parents[1] / "examples"
     shutil.copy(examples / "line.csv", tmp_path / "line.csv")
     shutil.copy(examples / "sphere-log.csv", tmp_path / "sphere-log.csv")
+    shutil.copy(examples / "fruit.csv", tmp_path / "fruit.csv")
     (tmp_path / "rec.csv").write_text("time [s],force [N]\n" + "".join(f"{k / 1000:.3f},0.0\n" for k in range(100)))
     files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv"), "REC": str(tmp_path / "rec.csv")}
     argv = [files.get(a, a) for a in argv]
@@ -878,3 +880,12 @@ def test_no_output_is_written_over_a_file_the_command_reads(cli, tmp_path):
     status, out, err = cli.run("safe-height", "--fruit", str(fruit), "--map", "surface", "--map-csv", str(fruit))
     assert status == 2 and "argument --map-csv:" in err and "is the file --fruit the command reads" in err
     assert fruit.read_bytes() == before
+
+
+def test_serve_on_an_address_not_this_machines_is_one_line(script, tmp_path):
+    """A refusal is one line: the warning that anyone on the network can use the app comes once it listens, not
+    before an address it cannot take (found by an attack: the warning, then the error)."""
+    done = script("serve", "--host", "192.0.2.1", "--port", "0", cwd=tmp_path)  # TEST-NET-1: never this machine's
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.strip().splitlines() == [
+        "fruitimpact serve: error: argument --host: cannot listen on 192.0.2.1:0: Cannot assign requested address"]

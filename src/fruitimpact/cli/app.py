@@ -42,11 +42,11 @@ def cmd_serve(args) -> int:
     except OSError as error:
         raise UsageError(f"argument --host: {host!r} is not an address: {error.strerror or error}") from None
     from fruitimpact.app import server  # tornado and the app only once the arguments are good
-    if not loopback:
-        print(f"{PROG} serve: warning: listening on {host}: anyone on that network can use this app "
-              f"(it has no login)", file=sys.stderr)
 
     def ready(bound_host, bound_port):
+        if not loopback:  # once it listens: an address it cannot take is one line, the refusal
+            print(f"{PROG} serve: warning: listening on {host}: anyone on that network can use this app "
+                  f"(it has no login)", file=sys.stderr, flush=True)
         shown = f"[{bound_host}]" if ":" in bound_host else bound_host
         print(f"{PROG} serve: http://{shown}:{bound_port}/ (Ctrl-C to stop)", flush=True)
 
