@@ -191,8 +191,7 @@ def main(argv=None) -> int:
         try:
             args = parser.parse_args(argv)
             if getattr(args, "func", None) is None:  # no command: a usage error like any other (one line, stderr)
-                commands = next(action for action in parser._actions if action.dest == "command").choices
-                parser.error(f"argument COMMAND: a command is required, one of {', '.join(commands)} "
+                parser.error(f"argument COMMAND: a command is required, one of {', '.join(COMMANDS)} "
                              f"(fruitimpact --help describes them)")
             if not interpreted:
                 return args.func(args)

@@ -173,8 +173,9 @@ def cmd_analyze(args) -> int:
         progress.update(done, analyzer.impacts, final=True)
     if not args.json:
         print(f"{analyzer.impacts} impacts in {done / source.rate:.4g} s")
-        if analysis.velocity is None and not (analysis.fit and analysis.mass is not None):
-            print(_speeds_read(analyzer.line_speeds()))
+        speeds = analyzer.line_speeds()
+        if speeds is not None:
+            print(_speeds_read(speeds))
     if args.plot:
         from fruitimpact.plotting import save_figure
         from fruitimpact.plotting.signals import analysis_figure

@@ -126,9 +126,12 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     rest_height = check_number("rest_height", rest_height, low=0.0, low_inclusive=False, high=1.0,
                                high_inclusive=True)
     max_impacts = read_count("max_impacts", max_impacts, 1, 1000)
-    if inputs.get("partner_mass") is not None or inputs.get("surface") == "fruit" \
-            or inputs.get("surface_model") == "fruit":  # said at once; a partner resolved otherwise, below
-        raise InputError(FREE_PARTNER, "surface")
+    from fruitimpact.library.catalogue import surfaces
+
+    surface = inputs.get("surface").strip() if isinstance(inputs.get("surface"), str) else None
+    partner = surface in surfaces() and surfaces()[surface].partner is not None
+    if partner or inputs.get("partner_mass") is not None:
+        raise InputError(FREE_PARTNER, "surface")  # every way to a free partner, before the engine
     # the engine only now: every argument above is answered without it
     from fruitimpact.impact.evaluation import evaluate_inputs
     from fruitimpact.impact.inputs import read_columns
@@ -139,7 +142,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     first = evaluate_inputs(read, messages, detail=True)
     if first.status[0] == 3:  # invalid: the one-line refusal, naming the argument
         raise InputError(messages.text(0), messages.argument(0))
-    if math.isfinite(first.columns["partner_mass"][0]):  # as resolved: surface "fruit" (any spelling), partner_mass
+    if math.isfinite(first.columns["partner_mass"][0]):  # as the table resolved it (any spelling it accepts)
         raise InputError(FREE_PARTNER, "surface")
     height = float(first.columns["drop_height"][0])
     criterion = first.columns["criterion"][0]

@@ -696,6 +696,15 @@ def evaluation(table, *, tabulated: bool | None = None, errors=None) -> Evaluati
 
 
 
+def validate(table) -> MessageBook:
+    """The refusals ``evaluate`` would give each row of ``table`` (as its ``messages``), without computing a row:
+    every check the inputs alone decide, with no compiled engine loaded (the exact calibration's table limit is
+    left to the computation)."""
+    inputs, messages = read_columns(table)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        return _evaluate(inputs, messages, None, False, False, validate_only=True)
+
+
 def refuse_constants(constants: dict, text: dict, given=()) -> None:
     """Refuse, before a run of many rows, a constant input out of its range or an input that the constants need
     and nobody gave (the energy criterion's threshold, a failure stress the fruit lacks): it would refuse every
@@ -706,9 +715,7 @@ def refuse_constants(constants: dict, text: dict, given=()) -> None:
         return
     # the row validated, not computed: no compiled engine, so that a refusal after it (a missing output, another
     # job's parts) is answered at once too
-    inputs, messages = read_columns({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
-        messages = _evaluate(inputs, messages, None, False, False, validate_only=True)
+    messages = validate({**{k: [v] for k, v in constants.items()}, **{k: [v] for k, v in text.items()}})
     message = messages.text(0)
     # the input a refusal names (its argument), else its first word: "plastic contact (--yield-pressure ...)"
     # is about yield_pressure
@@ -796,4 +803,5 @@ def curves(table, times=None, points: int = 201):
 
 
 __all__ = ["DEPENDENT_INPUTS", "Evaluation", "HERTZ_RANGE", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES",
-           "curves", "evaluate", "evaluate_inputs", "evaluation", "refuse_constants"]
+           "curves", "evaluate", "evaluate_inputs", "evaluation", "refuse_constants",
+           "validate"]

@@ -414,7 +414,7 @@ class LineAnalyzer:
         report["message"] = message
         return report
 
-    def _reads_speed(self) -> bool:
+    def reads_speed(self) -> bool:
         """Whether the impact speed is read from the rebounds: neither given nor found by each fit (the mass
         given)."""
         analysis = self.analysis
@@ -424,7 +424,7 @@ class LineAnalyzer:
         """The impact speed [m/s] of ``lane``'s fruit: the analysis's own (``velocity``, from the drop height), else
         the one the lane's rebounds show (``SPEED_MIN_REBOUNDS`` clear first rebounds of new fruit agreeing within
         ``SPEED_SPREAD``), else None; None too when the mass is given (then each fit finds its fruit's speed)."""
-        if not self._reads_speed():
+        if not self.reads_speed():
             return self.analysis.velocity
         speeds = np.asarray(self._speeds.get(lane, []))
         if speeds.size < SPEED_MIN_REBOUNDS:
@@ -437,7 +437,7 @@ class LineAnalyzer:
         """Keep the impact speed that ``rebound``'s flight shows, V = g · flight / (2 r), when it is a clear first
         rebound (not ambiguous) of a measured new fruit of ``lane`` (``line_speed``).  Its flight was not tested
         against a speed read so (``PulseSummary.speed_read``), so a lane whose speed changes is read anew."""
-        if not self._reads_speed() or verdict.ambiguous or parent.virtual or not verdict.speed_ratio:
+        if not self.reads_speed() or verdict.ambiguous or parent.virtual or not verdict.speed_ratio:
             return
         if not any(fruit.sequence == parent.sequence for fruit in self._fruit.get(lane, [])):
             return  # a rebound's own bounce: its parent's speed is a guess

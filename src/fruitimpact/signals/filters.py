@@ -10,6 +10,7 @@ import numba as nb
 import numpy as np
 
 from fruitimpact.engine.jitcache import CACHE
+from fruitimpact.signals.settings import check_cutoff
 
 __all__ = ["butterworth_sos", "solve_small"]
 
@@ -19,8 +20,7 @@ def butterworth_sos(cutoff: float, order: int, rate: float) -> np.ndarray:
     low-pass of ``order`` with its −3 dB point at ``cutoff`` [Hz] for ``rate`` [Hz]: the analogue
     prototype's pole pairs at angles π(2k − 1)/(2N) from the imaginary axis, bilinear transform with
     the cutoff prewarped (K = tan(π f_c/rate)); each section has unit gain at DC."""
-    if not 0 < cutoff < rate / 2:
-        raise ValueError(f"lowpass_cutoff must be in (0, rate/2) = (0, {rate / 2:g}) Hz; got {cutoff!r}")
+    check_cutoff(cutoff, rate)
     k = math.tan(math.pi * cutoff / rate)
     rows = []
     for j in range(order // 2):

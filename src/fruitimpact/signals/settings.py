@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 #: Most lanes (force channels) of one recording or stream: analyze, stream and the web app's pages.
 MAX_LANES = 256
 
-__all__ = ["MAX_LANES", "Analysis", "DetectorSettings", "at_rate", "in_samples"]
+__all__ = ["MAX_LANES", "Analysis", "DetectorSettings", "at_rate", "check_cutoff", "in_samples"]
 
 
 @dataclass(frozen=True)
@@ -176,9 +176,15 @@ def at_rate(settings: DetectorSettings, rate: float) -> dict:
         if not out["hum_gain"] < 0.5:
             raise ValueError(f"hum_q must be > {4 * math.pi * s.hum_frequency / rate:g} at {rate:g} Hz "
                              f"(a notch narrower than a quarter of the sample rate); got {s.hum_q!r}")
-    if s.lowpass_cutoff is not None and not 0 < s.lowpass_cutoff < rate / 2:
-        raise ValueError(f"lowpass_cutoff must be in (0, rate/2) = (0, {rate / 2:g}) Hz; got {s.lowpass_cutoff!r}")
+    if s.lowpass_cutoff is not None:
+        check_cutoff(s.lowpass_cutoff, rate)
     return out
+
+
+def check_cutoff(cutoff: float, rate: float) -> None:
+    """A low-pass cutoff [Hz] must lie in (0, rate/2): the Nyquist frequency of ``rate`` [Hz]; ValueError."""
+    if not 0 < cutoff < rate / 2:
+        raise ValueError(f"lowpass_cutoff must be in (0, rate/2) = (0, {rate / 2:g}) Hz; got {cutoff!r}")
 
 
 #: Longest rebound flight considered when the impact speed is unknown [s] (V ≤ 1.5 m/s: drops ≤ 11 cm).

@@ -395,9 +395,12 @@ class StreamAnalyzer:
                 self.close()
         return self.summary()
 
-    def line_speeds(self) -> dict:
-        """Each lane's impact speed [m/s] as the analysis knows it now (``LineAnalyzer.line_speed``: the given one,
-        or the one its rebounds show without a drop height; None when not known), by lane name."""
+    def line_speeds(self) -> dict | None:
+        """Each lane's impact speed [m/s] read from its rebounds (``LineAnalyzer.line_speed``; None for a lane whose
+        rebounds gave none), by lane name; None when the speed is not read from rebounds (given as a drop height
+        or velocity, or found by each fit from the mass: ``LineAnalyzer.reads_speed``)."""
+        if not self._analyzer.reads_speed():
+            return None
         return {name: self._analyzer.line_speed(lane) for lane, name in enumerate(self.lane_names)}
 
     def summary(self) -> dict:
