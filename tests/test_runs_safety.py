@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import errno
 import json
+import math
 import os
 import subprocess
 import sys
@@ -338,7 +339,11 @@ def test_a_cell_that_is_not_utf8_or_a_column_of_another_type_is_a_bad_row_not_a_
     (["sweep", "--velocity", "1,nan", "-o", "a.csv"], "argument --velocity: each value must be a number, not NaN"),
     (["sweep", "--veloc", "1,2", "-o", "a.csv"], "unrecognized arguments: --veloc"),  # no completion to --velocity
     (["population", "-n", "10", "--threshold", "peak_force>nan"], "a threshold's value must be a finite number"),
-    (["population", "-n", "10", "--mass", "sample(rag.csv:mass)"], "sample: cannot read 'rag.csv': Error tokenizing"),
+    (["population", "-n", "10", "--mass", "sample(rag.csv:mass)"],
+     "sample: line 3 of 'rag.csv' has 3 fields where the header has 2: a ragged row is not read"),
+    # a short row in another column than the sampled one: pandas would fill it, and the file is malformed
+    (["population", "-n", "10", "--mass", "sample(short.csv:mass)"],
+     "sample: line 4 of 'short.csv' has 1 field where the header has 2: a ragged row is not read"),
     (["line", "dup.csv", "-n", "10", "--fruit", "apple"], "transfer point 'a' is named twice"),
     # a constant that refuses every row (found by an attack: each ran and printed "0 ok, 10 invalid", exit 0)
     (["population", "-n", "10", "--step", "0"], "argument --step: step must be a finite number > 0 s"),
@@ -354,6 +359,7 @@ def test_more_bad_runs_are_one_line_before_work(tmp_path, cli, monkeypatch, argv
     (tmp_path / "IN").write_text("")
     (tmp_path / "in.csv").write_text("mass\n0.1\n")
     (tmp_path / "rag.csv").write_text("mass,velocity\n0.1,1\n0.12,1,3\n")
+    (tmp_path / "short.csv").write_text("mass,velocity\n0.1,1\n\n0.12\n")
     (tmp_path / "dup.csv").write_text("name,drop_height,surface\na,10cm,steel\na,5cm,wood\n")
     argv = ["in.csv" if a == "IN" else a for a in argv]
     assert words in cli.error(*argv)
@@ -366,3 +372,29 @@ def test_a_figure_with_nothing_to_draw_is_not_written(tmp_path, cli):
                      "bruise_volume")
     assert line.startswith("fruitimpact sweep: error: argument --criterion: criterion must be given for bruise_volume")
     assert not (tmp_path / "p.png").exists()
+
+
+def test_a_step_too_coarse_for_every_fruit_of_a_lot_or_grid_is_refused_before_work(tmp_path, cli):
+    # rk4's step bound depends on the fruit (1/20 of the undamped Hertz contact duration): a constant step that is
+    # refused for every member is a usage error (each run used to print "0 ok, N invalid" and exit 0)
+    line = cli.error("population", "-n", "500", "--method", "rk4", "--step", "1s")
+    assert line.startswith("fruitimpact population: error: argument --step: step must be at most 1/20 of the contact")
+    assert line.endswith("every one of the lot's first 500 fruit is refused for it")
+    line = cli.error("sweep", "--velocity", "0.5:1:3", "-o", tmp_path / "a.csv", "--method", "rk4", "--step", "1s")
+    assert line.endswith("every one of the grid's 3 points is refused for it")
+    assert not (tmp_path / "a.csv").exists() and not list(tmp_path.iterdir())
+
+
+def test_a_step_that_some_fruit_of_a_lot_meet_leaves_the_others_to_their_rows(cli):
+    # Hertz closed form of the undamped contact duration (Johnson 1985, §11.4), T = 2.9432 δ_max / v with
+    # δ_max = (5 m v² / (4 K))^(2/5), K = 4/3 E* √R:
+    # a step of T/20 at 1 m/s suits the slower half of a lot whose speed spans 0.5–1.5 m/s and not the faster
+    # (T falls with v^(-1/5)), so the run goes ahead and the faster rows alone are invalid
+    mass, radius, modulus, poisson = 0.115, 0.0325, 3e6, 0.3
+    stiffness = 4.0 / 3.0 * modulus / (1 - poisson ** 2) * math.sqrt(radius)
+    duration = 2.9432 * (5 * mass * 1.0 ** 2 / (4 * stiffness)) ** 0.4 / 1.0
+    out = cli.ok("population", "-n", "400", "--no-spreads", "--fruit", "jonathan-apple", "--mass", "115g",
+                 "--diameter", "65mm", "--modulus", "3MPa", "--poisson", "0.3", "--velocity", "uniform(0.5,1.5)",
+                 "--method", "rk4", "--step", f"{duration / 20:.6g}", "--json")
+    report = json.loads(out)
+    assert 100 < report["ok"] < 300 and report["ok"] + report["invalid"] == 400, report["statuses"]

@@ -229,6 +229,61 @@ class Sample:
         return f"sample({self.source}, n={self.values.size})"
 
 
+#: Cells read as "no value" in a sample CSV (pandas' default NA tokens, so that a file reads as it did with
+#: pandas): such a fruit was not measured, and it is left out of the sample, never given a value.
+_MISSING = frozenset(("", "#N/A", "#N/A N/A", "#NA", "-1.#IND", "-1.#QNAN", "-NaN", "-nan", "1.#IND", "1.#QNAN",
+                      "<NA>", "N/A", "NA", "NULL", "NaN", "None", "n/a", "nan", "null"))
+
+
+def _choose_column(path: str, header, column: str | None, default_column: str | None) -> str:
+    if column is None:
+        if default_column is not None and default_column in header:
+            return default_column
+        if len(header) == 1:
+            return header[0]
+        raise ValueError(f"sample: {path!r} has columns {', '.join(map(str, header))}; name one as "
+                         f"sample(FILE:COLUMN)")
+    if column not in header:
+        raise ValueError(f"sample: {path!r} has no column {column!r}")
+    return column
+
+
+def _csv_cells(path: str, column: str | None, default_column: str | None) -> tuple[str, list[str]]:
+    """(column, its cells that hold a value) of a sample CSV, read with the csv module (no pandas: a refusal in
+    ≤ 0.25 s).  Refused: a file that is not UTF-8 CSV, a column not in the header, and a row whose number of
+    fields is not the header's (a short row's missing cells would be measurements nobody made)."""
+    import csv
+
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:  # a BOM is not in a name
+            reader = csv.reader(handle)
+            header = [name.strip() for name in next(reader, [])]
+            if not header:
+                raise ValueError(f"sample: {path!r} is empty: it needs a header and at least one value")
+            column = _choose_column(path, header, column, default_column)
+            index, cells = header.index(column), []
+            for row in reader:
+                if not row:  # a blank line is no row
+                    continue
+                if len(row) != len(header):
+                    raise ValueError(f"sample: line {reader.line_num} of {path!r} has {len(row)} field"
+                                     f"{'' if len(row) == 1 else 's'} where the header has {len(header)}: a "
+                                     f"ragged row is not read")
+                if row[index].strip() not in _MISSING:
+                    cells.append(row[index].strip())
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"sample: cannot read {path!r}: {exc}") from None
+    return column, cells
+
+
+def _numbers(cells, dimension: str) -> np.ndarray:
+    """Cells (text) → values [SI]: plain numbers at once, else each through the unit parser."""
+    try:
+        return np.array(cells, dtype=float)
+    except ValueError:  # a unit or a word in a cell
+        return np.array([parse_quantity(c, dimension) for c in cells], dtype=float)
+
+
 def _read_sample(argument: str, dimension: str, default_column: str | None) -> Sample:
     """``FILE[:COLUMN]`` → Sample; the column defaults to ``default_column`` or the file's only column."""
     path, column = argument, None
@@ -239,37 +294,23 @@ def _read_sample(argument: str, dimension: str, default_column: str | None) -> S
     suffix = Path(path).suffix.lower()
     if suffix not in (".csv", ".parquet", ".pq"):
         raise ValueError(f"sample: {path!r} must be .csv or .parquet")
-    if suffix == ".csv" and column is not None:  # a column not in the header: said before pandas loads (0.3 s)
-        import csv
+    if suffix == ".csv":
+        column, cells = _csv_cells(path, column, default_column)
+        numeric = False
+    else:
+        import pandas as pd  # (0.3 s) once the file is there
 
         try:
-            with open(path, newline="", encoding="utf-8-sig") as handle:  # a BOM is not in a name
-                header = next(csv.reader(handle), [])
-        except (OSError, UnicodeDecodeError):
-            header = None  # pandas says what is wrong with the file, below
-        if header is not None and column not in header:
-            raise ValueError(f"sample: {path!r} has no column {column!r}")
-    import pandas as pd  # (0.3 s) once the file is there
-
+            frame = pd.read_parquet(path)
+        except (ValueError, OSError) as exc:  # not Parquet: one line
+            lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+            raise ValueError(f"sample: cannot read {path!r}: {lines[0] if lines else type(exc).__name__}") \
+                from None
+        column = _choose_column(path, list(frame.columns), column, default_column)
+        cells = frame[column].dropna()
+        numeric = cells.dtype.kind in "fiu"
     try:
-        frame = pd.read_parquet(path) if suffix != ".csv" else pd.read_csv(path)
-    except (ValueError, OSError, UnicodeDecodeError) as exc:  # a ragged row, not UTF-8, not Parquet: one line
-        lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
-        raise ValueError(f"sample: cannot read {path!r}: {lines[0] if lines else type(exc).__name__}") from None
-    if column is None:
-        if default_column is not None and default_column in frame:
-            column = default_column
-        elif frame.shape[1] == 1:
-            column = frame.columns[0]
-        else:
-            raise ValueError(f"sample: {path!r} has columns {', '.join(map(str, frame.columns))}; "
-                             f"name one as sample(FILE:COLUMN)")
-    if column not in frame:
-        raise ValueError(f"sample: {path!r} has no column {column!r}")
-    cells = frame[column].dropna()
-    try:
-        values = np.array([parse_quantity(c, dimension) for c in cells], dtype=float) \
-            if cells.dtype.kind not in "fiu" else cells.to_numpy(dtype=float)
+        values = cells.to_numpy(dtype=float) if numeric else _numbers(cells, dimension)
     except ValueError as exc:
         raise ValueError(f"sample: column {column!r}: {exc}") from None
     if values.size == 0 or not np.all(np.isfinite(values)):

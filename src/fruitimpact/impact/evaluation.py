@@ -728,6 +728,21 @@ def refuse_constants(constants: dict, text: dict, given=()) -> None:
         raise InputError(message, name)
 
 
+def refuse_lot(columns, given, what: str) -> None:
+    """Refuse, before a run, a constant of the user's that a bound depending on other inputs refuses for every
+    member of ``columns`` (the first members of a lot, or a whole grid): a step too coarse for rk4 for every fruit,
+    which :func:`refuse_constants` leaves to the rows because a lot's other fruit may meet it.  Refused only when
+    every row is refused, for one and the same input, and that input is in ``given`` (the inputs the user set to
+    one value); ``InputError`` with the rows' message and ``what`` they are ("the lot's first 4,096 fruit")."""
+    messages = validate(columns)
+    rows = len(messages.codes)
+    if rows == 0 or not messages.flagged.all() or len(np.unique(messages.codes)) != 1:
+        return
+    name = messages.argument(0)
+    if name in set(given):
+        raise InputError(f"{messages.text(0)}; every one of {what} is refused for it", name)
+
+
 def evaluate(table, *, tabulated: bool | None = None, errors=None) -> "pandas.DataFrame":  # noqa: F821
     """Characteristics of every row of ``table``.
 
@@ -803,5 +818,5 @@ def curves(table, times=None, points: int = 201):
 
 
 __all__ = ["DEPENDENT_INPUTS", "Evaluation", "HERTZ_RANGE", "LAW_COLUMNS", "OUTPUT_COLUMNS", "REGISTRIES",
-           "curves", "evaluate", "evaluate_inputs", "evaluation", "refuse_constants",
+           "curves", "evaluate", "evaluate_inputs", "evaluation", "refuse_constants", "refuse_lot",
            "validate"]

@@ -28,6 +28,8 @@ _LEGACY_STREAMS = ("mass", "diameter", "modulus", "poisson", "stiffness", "veloc
                    "alpha", "step")
 #: Random stream of the percentile-sample keys.
 KEY_STREAM = 1000
+#: Members of a lot validated before a run (``read_lot``): enough to see the lot's spread, a few ms of checks.
+PILOT_ROWS = 4096
 
 
 def stream_number(name: str) -> int:
@@ -154,6 +156,13 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     if bases:
         extra, described = _one_bruise_basis(extra, described, dict(bases), distributions, text)
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
+    if not excluded and not fixed:
+        # a bound that depends on the drawn fruit (rk4's step) is judged on the lot's first members, as drawn;
+        # not where each point or axis sets inputs later (the members' rows are not yet what will be computed)
+        from fruitimpact.impact.evaluation import refuse_lot
+
+        pilot = min(rows, PILOT_ROWS)
+        refuse_lot(source.inputs(0, pilot, None)[0], list(constants) + list(text), f"the lot's first {pilot:,} fruit")
     return source, text, tuple(described)
 
 
