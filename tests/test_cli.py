@@ -737,6 +737,26 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     unknown alternative surface, a sphere's setting or calibration file) may load NumPy (0.1 s) but not the
     compiled engine (numba, 0.7 s): it loads only where a row is computed.  Each was a 0.7-1 s answer before; a
     population of identical refusals (``--model tsuji --yield-pressure``) was 10 invalid rows and exit 0."""
+    assert not {name for name in _refusal_imports(argv, line, tmp_path) if name.split(".")[0] == "numba"}, argv
+
+
+@pytest.mark.parametrize("argv, line", [
+    # the rate read from a recording's first rows (Arrow's to_numpy imported pandas: 0.43 s)
+    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500]"),
+    # a sample CSV read with the csv module: a text column, a ragged row (pandas read the file: 0.41 s)
+    (["population", "--mass", "sample(fruit.csv:model)"], "argument --mass: sample: column 'model': cannot read"),
+    (["population", "--mass", "sample(ragged.csv:mass)"], "argument --mass: sample: line 3 of 'ragged.csv' has 1"),
+    # a step refused for every fruit of the lot (it ran every row invalid and exited 0)
+    (["population", "-n", "100", "--method", "rk4", "--step", "1s"], "every one of the lot's first 100 fruit")])
+def test_a_usage_error_about_a_file_or_a_lot_loads_neither_numba_nor_pandas(argv, line, tmp_path):
+    """Issue 15 item 4 (≤ 0.25 s): pandas alone takes 0.3 s to import; these refusals need neither it nor numba."""
+    imported = _refusal_imports(argv, line, tmp_path)
+    assert not {name for name in imported if name.split(".")[0] in ("numba", "pandas")}, argv
+
+
+def _refusal_imports(argv, line, tmp_path) -> set:
+    """The modules the console script imported to refuse ``argv`` (LINE, LOG, REC, fruit.csv and ragged.csv
+    stand for files made here) with one line holding ``line``, exit 2."""
     import os
     import shutil
     import subprocess
@@ -748,6 +768,7 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     shutil.copy(examples / "line.csv", tmp_path / "line.csv")
     shutil.copy(examples / "sphere-log.csv", tmp_path / "sphere-log.csv")
     shutil.copy(examples / "fruit.csv", tmp_path / "fruit.csv")
+    (tmp_path / "ragged.csv").write_text("mass,velocity\n0.1,1\n0.12\n")
     (tmp_path / "rec.csv").write_text("time [s],force [N]\n" + "".join(f"{k / 1000:.3f},0.0\n" for k in range(100)))
     files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv"), "REC": str(tmp_path / "rec.csv")}
     argv = [files.get(a, a) for a in argv]
@@ -758,7 +779,8 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     assert done.returncode == 2 and len(messages) == 1 and line in messages[0], done.stderr[-2000:]
     imported = {text.rsplit("|", 1)[-1].strip() for text in done.stderr.splitlines() if text.startswith("import time:")}
     assert "fruitimpact.cli" in imported  # the log is there: the check below can fail
-    assert not {name for name in imported if name.split(".")[0] == "numba"}, argv
+    return imported
+
 
 @pytest.mark.parametrize("argv, line", [
     (["serve", "--port", "²"], "argument --port: port must be an integer in [0, 65,535]; got '²'"),

@@ -284,7 +284,12 @@ def _fast_values(clean, rows: int, ncols: int, delimiter, used) -> np.ndarray | 
         array = table.column(name)
         if array.null_count:
             return None
-        out[:, k] = array.to_numpy()
+        # each chunk's data buffer as it is: Arrow's to_numpy imports pandas (0.3 s, in a usage error too)
+        row = 0
+        for chunk in array.chunks:
+            out[row:row + len(chunk), k] = np.frombuffer(chunk.buffers()[1], dtype=np.float64, count=len(chunk),
+                                                         offset=chunk.offset * 8)
+            row += len(chunk)
     if not np.isfinite(out).all():
         return None
     return out
