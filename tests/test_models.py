@@ -159,3 +159,36 @@ def test_models_cli(capsys, tmp_path):
     assert (tmp_path / "t.png").stat().st_size > 1000
     assert main(["models", "--targets", "1.5"]) == 2
     assert "--targets" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name, chi", [("herbert-mcwhannell", lambda e: 6 * (1 - e) / ((2 * e - 1) ** 2 + 3)),
+                                      ("zhiying-qishao", lambda e: 3 * (1 - e * e) * math.exp(2 * (1 - e)) / 4)])
+def test_the_lowest_restitution_a_finite_law_reaches_is_what_its_page_says(name, chi):
+    """A law whose χ = c V stays finite as its target e → 0 cannot calibrate below the restitution of x = χ(0):
+    the root of Hunt & Crossley's exact relation (1 + x) = (1 − e x) exp((1 + e) x), found here by brentq (not
+    the engine).  The registry's stated floor is that root rounded down (it said 0.49 and 0.18, both above the
+    true 0.4877 and 0.1787: found by a physics audit)."""
+    from scipy.optimize import brentq
+
+    def root(x):
+        return brentq(lambda e: (1 - e * x) * math.exp((1 + e) * x) - (1 + x), 1e-9, 1 - 1e-9, xtol=1e-15)
+
+    floor = root(chi(0.0))
+    achieved = simulate(model=name, calibration="paper", restitution=1e-6).characteristics.restitution
+    assert achieved == pytest.approx(root(chi(1e-6)), rel=1e-9)  # the law's χ at the target asked for
+    stated = float(DAMPING_LAWS[name].validity.split("never falls below ")[1].split()[0])
+    assert stated <= floor < stated + 1e-3
+
+
+@pytest.mark.parametrize("method, step", [("accurate", 1e-4), ("rk4", 2e-5), ("rk4", 1e-5)])
+def test_a_kelvin_voigt_peak_at_first_touch_is_read_there_and_said(method, step):
+    """Heavy Kelvin–Voigt damping: at first touch F = k·0 + b V (the dashpot alone) exceeds every later force, so the
+    peak is at t = 0 and C = F_max/t_c, C* are undefined.  RK4 read its peak from the first step on, with F(0)
+    set to 0: t_c = one step and C growing as 1/step (2e-5 s: 6.0e6 N/s; 1e-5 s: 1.2e7), status ok (found by a
+    physics audit).  Reference: the law itself, F(0) = b V with b the reported damping [N·s/m]."""
+    result = simulate(model="kelvin-voigt", restitution=0.1, velocity=1.5, method=method, step=step)
+    b = result.law.damping_factor * result.law.stiffness  # c = b/k for the linear law
+    assert result.characteristics.peak_force == pytest.approx(b * 1.5, rel=1e-12)
+    assert result.characteristics.time_to_peak == 0.0 and math.isnan(result.characteristics.firmness_c)
+    assert result.curves.force[0] == pytest.approx(b * 1.5, rel=1e-12)
+    assert any("first touch (t_c = 0)" in text for text in result.warnings)

@@ -58,7 +58,7 @@ import math
 import numba as nb
 import numpy as np
 
-from fruitimpact.engine.codes import ABSORBED_ENERGY, EXIT_VELOCITY, N_CHARACTERISTICS, RESTITUTION
+from fruitimpact.engine.codes import N_CHARACTERISTICS
 from fruitimpact.engine.halfspace import halfspace_impact
 from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.plasticforms import (N_PLASTIC, PLASTIC_COLUMNS, winkler_stiffness,  # noqa: F401  (re-exported)
@@ -79,9 +79,9 @@ PARALLEL_MIN_ROWS = 2000
 
 # ---------------------------------------------------------------------------------------------
 # the branches, parametrised by the rate-independent force F (p: the row's parameters)
-# p = (K, R, E*, F_y, δ_y, kp = π p_y R, K_L, F_b, h, K_p, δ_p)
+# p = (K, R, E*, F_y, δ_y, kp = π p_y R, K_L, F_b, h, K_p, δ_p, crushed)
 # ---------------------------------------------------------------------------------------------
-K_, R_, ES_, FY_, DY_, KP_, KL_, FB_, H_, KU_, DP_ = range(11)
+K_, R_, ES_, FY_, DY_, KP_, KL_, FB_, H_, KU_, DP_, CR_ = range(12)
 
 
 @nb.njit(**_JIT)
@@ -95,6 +95,15 @@ def _layer(F, p):
         d = math.sqrt(F / KL)
         return d, (0.5 / math.sqrt(KL * F) if F > 0.0 else math.inf), 2.0 / 3.0 * F * d
     return p[H_], 0.0, 2.0 / 3.0 * FB * p[H_] + p[H_] * (F - FB)
+
+
+@nb.njit(**_JIT)
+def _layer_unload(F, p):
+    """``_layer`` on the unloading branch: the layer unloads along its loading curve, except a board that
+    crushed (``CR_``: it reached F_b and its flutes collapsed), which stays flat at δ_L = h and returns nothing."""
+    if p[CR_] > 0.0:
+        return p[H_], 0.0, p[H_] * F
+    return _layer(F, p)
 
 
 @nb.njit(**_JIT)
@@ -129,7 +138,7 @@ def load_work(F, p):
 def unload_energy(F, p):
     """U(F): the elastic energy the unloading branch returns between F and 0 [J]."""
     df, _, i_f = _fruit_unload(F, p)
-    dl, _, i_l = _layer(F, p)
+    dl, _, i_l = _layer_unload(F, p)
     return F * (df - p[DP_] + dl) - i_f - i_l
 
 
@@ -140,7 +149,7 @@ def _load_slope(F, p):
 
 @nb.njit(**_JIT)
 def _unload_slope(F, p):
-    return _fruit_unload(F, p)[1] + _layer(F, p)[1]
+    return _fruit_unload(F, p)[1] + _layer_unload(F, p)[1]
 
 
 @nb.njit(**_JIT)
@@ -287,7 +296,11 @@ def _largest(mass, c, energy, p, F_star, pressure, yield_pressure):
     best = -1.0
     where = F_star
     for k in range(n - 1):
-        for F_try in (ends[k + 1], _root_on(ends[k], ends[k + 1], mass, c, energy, p, pressure, yield_pressure)):
+        # the piece's end, its stationary point, and the right limit at its start (where the value jumps: the
+        # pressure of a board that crushed at F_b; elsewhere that limit is the previous piece's end)
+        start = ends[k] * (1.0 + 1e-12) if ends[k] > 0.0 else -1.0
+        for F_try in (ends[k + 1], _root_on(ends[k], ends[k + 1], mass, c, energy, p, pressure, yield_pressure),
+                      start):
             if F_try <= 0.0:
                 continue
             v = speed_of_energy(mass, c, energy - load_work(F_try, p))
@@ -406,25 +419,31 @@ def _pressure_at(F, p, yield_pressure):
     sphere on a Winkler layer's a² = 2 R δ_L) and a shape factor interpolated between Hertz's
     3/2 and the layer's paraboloid 2 by the share of each in a²: an approximation (docs/damage.md).
     Beyond the bottoming-out force F_b, the excess F − F_b presses on the substrate through the crushed pad:
-    its Hertz pressure (6 (F − F_b) E*² / (π³ R²))^(1/3) if that is larger."""
+    its Hertz pressure (6 (F − F_b) E*² / (π³ R²))^(1/3) if that is larger.  A board that crushed (``CR_``)
+    spreads nothing beyond F_b: the whole force is the fruit's Hertz contact on the floor (a² = R δ_f)."""
     deflection_fruit = _fruit_load(F, p)[0]
     deflection_layer = _layer(F, p)[0]
+    if F > p[FB_] and p[CR_] > 0.0:
+        deflection_layer = 0.0
     a2 = p[R_] * (deflection_fruit + 2.0 * deflection_layer)
     if a2 <= 0.0:
         return 0.0, 0.0
     shape = (1.5 * deflection_fruit + 4.0 * deflection_layer) / (deflection_fruit + 2.0 * deflection_layer)
     pressure = shape * F / (math.pi * a2)
-    if F > p[FB_]:  # a bottomed-out pad: the force beyond F_b meets the substrate, a Hertz contact of its own
+    if F > p[FB_] and not p[CR_] > 0.0:  # a bottomed-out pad: the force beyond F_b meets the substrate alone
         R = p[R_]
         pressure = max(pressure, (6.0 * (F - p[FB_]) * p[ES_] ** 2 / (math.pi ** 3 * R * R)) ** (1.0 / 3.0))
     return min(pressure, yield_pressure), math.sqrt(a2)
 
 
 @nb.njit(**_JIT)
-def _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness, thickness, c):
+def _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness, thickness, c,
+           crushes):
     """(parameters p, energy the contact takes E_in [J], largest rate-independent force F* [N]),
-    with the unloading branch fixed by F* (Thornton's R_p and δ_p)."""
-    p = np.empty(11)
+    with the unloading branch fixed by F* (Thornton's R_p and δ_p; a board that ``crushes`` at F_b crushed when
+    F* > F_b)."""
+    p = np.empty(12)
+    p[CR_] = 0.0
     p[K_] = stiffness
     p[R_] = radius
     p[ES_] = contact_modulus
@@ -444,6 +463,8 @@ def _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, l
     # undamped elastic Hertz force for the same energy: the bracket's start
     guess = stiffness ** 0.4 * (2.5 * energy) ** 0.6
     F_star = _solve_max_force(energy, p, guess)
+    if crushes and F_star > p[FB_]:
+        p[CR_] = 1.0
     df_star = _fruit_load(F_star, p)[0]
     if F_star > p[FY_]:
         FY = p[FY_]
@@ -479,14 +500,15 @@ def _layered_impact(mass, c, energy, returned, p, F_star, yield_pressure, nodes,
 
 @nb.njit(**_JIT)
 def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness,
-                thickness, c, nodes, weights, out, extra):
+                thickness, c, crushes, nodes, weights, out, extra):
     """One impact: the characteristics into ``out`` (``codes.CHARACTERISTIC_COLUMNS``) and
     ``PLASTIC_COLUMNS`` into ``extra``.  ``yield_pressure`` = inf: elastic fruit;
-    ``layer_stiffness`` = inf: a half-space surface (no layer)."""
+    ``layer_stiffness`` = inf: a half-space surface (no layer); ``crushes``: the layer is a board that crushes
+    at its bottoming force (``crushing_characteristics``)."""
     p, energy, F_star = _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
-                               layer_stiffness, thickness, c)
+                               layer_stiffness, thickness, c, crushes)
     df_star = _fruit_load(F_star, p)[0]
-    dl_star = _layer(F_star, p)[0]
+    dl_star = _layer(F_star, p)[0]  # the board's depth: the same on loading and (crushed) after
     loaded = load_work(F_star, p)
     returned = unload_energy(F_star, p)
     exit_speed = rebound_speed_of_energy(mass, c, returned)
@@ -527,17 +549,20 @@ def plastic_row(mass, velocity, stiffness, radius, contact_modulus, yield_pressu
     # the fruit's share of the work of deformation at the turn (the rest is the layer's)
     df, _, i_f = _fruit_load(F_star, p)
     extra[6] = (F_star * df - i_f) / loaded if loaded > 0.0 else 1.0
+    if p[CR_] > 0.0:  # a crushed board keeps its F_b h/3 (its collapse): the rest of what was absorbed is the fruit's
+        absorbed = out[7]
+        extra[6] = max(absorbed - p[FB_] * p[H_] / 3.0, 0.0) / absorbed if absorbed > 0.0 else 0.0
     # Thornton's R_p of the flattened contact ((4/3) E* √R_p = K_p; R when it did not yield)
     extra[7] = (0.75 * p[KU_] / contact_modulus) ** 2
 
 
 @nb.njit(**_JIT)
 def _curve_points(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness, thickness,
-                  c, nodes, weights, n):
+                  c, crushes, nodes, weights, n):
     """Time [s], deflection [m], rate [m/s] and force [N] at 2n points along loading then unloading,
     parametrised by the rate-independent force (dense near the turn and the ends)."""
     p, energy, F_star = _setup(mass, velocity, stiffness, radius, contact_modulus, yield_pressure, layer_stiffness,
-                               thickness, c)
+                               thickness, c, crushes)
     returned = unload_energy(F_star, p)
     t = np.empty(2 * n)
     d = np.empty(2 * n)
@@ -559,20 +584,22 @@ def _curve_points(mass, velocity, stiffness, radius, contact_modulus, yield_pres
         j = n + k
         t[j] = t_max + t_unload - (_branch_time(F, F_star, True, mass, c, returned, p, nodes, weights)
                                    if k > 0 else t_unload)
-        d[j] = _fruit_unload(F, p)[0] + _layer(F, p)[0]
+        d[j] = _fruit_unload(F, p)[0] + _layer_unload(F, p)[0]
         v[j] = -rebound_speed_of_energy(mass, c, returned - unload_energy(F, p))
         f[j] = F * (1.0 + c * v[j])
     return t, d, v, f
 
 
 def plastic_curves(points: int, mass, velocity, stiffness, radius, contact_modulus, yield_pressure=math.inf,
-                   layer_stiffness=math.inf, thickness=math.inf, damping_factor=0.0):
+                   layer_stiffness=math.inf, thickness=math.inf, damping_factor=0.0, crushes=False):
     """δ(t), δ̇(t), F(t) of one elastic–plastic impact on ``points`` equally spaced times over [0, T]:
-    (time [s], deflection [m], rate [m/s], force [N]) arrays, interpolated linearly between 2 × 400 exact points along the loading and unloading branches."""
+    (time [s], deflection [m], rate [m/s], force [N]) arrays, interpolated linearly between 2 × 400 exact points
+    along the loading and unloading branches.  ``crushes``: the layer is a board that crushes at its bottoming
+    force (``crushing_characteristics``)."""
     nodes, weights = gauss_jacobi(NODES, 0.0, 0.0)
     t, d, v, f = _curve_points(float(mass), float(velocity), float(stiffness), float(radius),
                                float(contact_modulus), float(yield_pressure), float(layer_stiffness),
-                               float(thickness), float(damping_factor), np.ascontiguousarray(nodes),
+                               float(thickness), float(damping_factor), bool(crushes), np.ascontiguousarray(nodes),
                                np.ascontiguousarray(weights), 400)
     order = np.argsort(t, kind="stable")
     t, d, v, f = t[order], d[order], v[order], f[order]
@@ -583,24 +610,24 @@ def plastic_curves(points: int, mass, velocity, stiffness, radius, contact_modul
 
 
 @nb.njit(parallel=True, **_JIT)
-def _kernel(mass, velocity, stiffness, radius, modulus, yield_pressure, layer, thickness, c, nodes, weights,
+def _kernel(mass, velocity, stiffness, radius, modulus, yield_pressure, layer, thickness, c, crushes, nodes, weights,
             out, extra):
     for i in nb.prange(mass.shape[0]):
         plastic_row(mass[i], velocity[i], stiffness[i], radius[i], modulus[i], yield_pressure[i], layer[i],
-                    thickness[i], c[i], nodes, weights, out[i], extra[i])
+                    thickness[i], c[i], crushes, nodes, weights, out[i], extra[i])
 
 
 @nb.njit(**_JIT)
-def _kernel_serial(mass, velocity, stiffness, radius, modulus, yield_pressure, layer, thickness, c, nodes, weights,
-                   out, extra):
+def _kernel_serial(mass, velocity, stiffness, radius, modulus, yield_pressure, layer, thickness, c, crushes, nodes,
+                   weights, out, extra):
     for i in range(mass.shape[0]):
         plastic_row(mass[i], velocity[i], stiffness[i], radius[i], modulus[i], yield_pressure[i], layer[i],
-                    thickness[i], c[i], nodes, weights, out[i], extra[i])
+                    thickness[i], c[i], crushes, nodes, weights, out[i], extra[i])
 
 
 def plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, yield_pressure=math.inf,
                             layer_stiffness=math.inf, thickness=math.inf, damping_factor=0.0,
-                            parallel: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
+                            parallel: bool | None = None, crushes: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Characteristics of elastic–plastic impacts, one row per impact.
 
     Parameters
@@ -623,6 +650,8 @@ def plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, 
         Layer thickness h [m] (bottoming out at δ_L = h); inf: never bottoms out.
     damping_factor : array_like
         c [s/m] of F = F_T (1 + c δ̇); 0: no viscous damping.
+    crushes : bool
+        The layer is a board that crushes where it would bottom out (``crushing_characteristics``).
 
     Returns
     -------
@@ -643,7 +672,7 @@ def plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, 
     extra = np.empty((rows, N_PLASTIC))
     nodes, weights = gauss_jacobi(NODES, 0.0, 0.0)
     kernel = _kernel if (parallel if parallel is not None else rows > PARALLEL_MIN_ROWS) else _kernel_serial
-    kernel(*arrays, np.ascontiguousarray(nodes), np.ascontiguousarray(weights), out, extra)
+    kernel(*arrays, bool(crushes), np.ascontiguousarray(nodes), np.ascontiguousarray(weights), out, extra)
     return out, extra
 
 
@@ -653,38 +682,17 @@ def crushing_characteristics(mass, velocity, stiffness, radius, contact_modulus,
 
     The board is the Winkler layer of ``plastic_characteristics`` up to its crush depth δ_c [m] (where the
     centre pressure k δ_L reaches its flat-crush strength σ_c: δ_c = σ_c/k).  An impact that does not reach
-    the crush force F_c = K_L δ_c² is that layer impact.  One that does crushes the flutes: the board has then
-    taken W_c = K_L δ_c³/3 [J] (the work of F = K_L δ_L² up to δ_c, lost in the crushed board) and the fruit
-    meets the floor, as on a rigid half-space, at the speed left, V' = √(V² − 2 W_c/m).  Reported for those
-    rows: the rigid impact at V' (forces, pressure, times, deflections of the fruit), the exit speed e' V', the
-    restitution e' V'/V, the absorbed energy ½ m (V² − (e' V')²) and the fruit's share of it (the board's W_c
-    is not the fruit's); ``bottomed_out`` is 1.  Arguments as for ``plastic_characteristics``."""
-    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
-                                   (mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
-                                    layer_stiffness, crush_depth, damping_factor)))
-    m, v, k, r, e_star, p_y, k_l, depth, c = (np.ascontiguousarray(a.ravel()) for a in arrays)
-    out, extra = plastic_characteristics(m, v, k, r, e_star, p_y, k_l, depth, c)
-    bottom = extra[:, PLASTIC_COLUMNS.index("bottomed_out")] == 1.0
-    crush_work = k_l * depth ** 3 / 3.0
-    left = v ** 2 - 2.0 * crush_work / m
-    crushed = np.flatnonzero(bottom & (left > 0.0))
-    if crushed.size:
-        v_left = np.sqrt(left[crushed])
-        rigid, rigid_extra = plastic_characteristics(m[crushed], v_left, k[crushed], r[crushed], e_star[crushed],
-                                                     p_y[crushed], math.inf, math.inf, c[crushed])
-        exit_speed = rigid[:, EXIT_VELOCITY]
-        total = 0.5 * m[crushed] * (v[crushed] ** 2 - exit_speed ** 2)
-        fruit = 0.5 * m[crushed] * (v_left ** 2 - exit_speed ** 2)
-        rigid[:, RESTITUTION] = exit_speed / v[crushed]
-        rigid[:, ABSORBED_ENERGY] = total
-        rigid_extra[:, PLASTIC_COLUMNS.index("bottomed_out")] = 1.0
-        rigid_extra[:, PLASTIC_COLUMNS.index("fruit_work_share")] = fruit / total
-        rigid_extra[:, PLASTIC_COLUMNS.index("yield_velocity")] = np.where(
-            np.isfinite(rigid_extra[:, 0]), np.sqrt(rigid_extra[:, 0] ** 2 + 2.0 * crush_work[crushed] / m[crushed]),
-            np.inf)  # the drop speed at which the fruit would yield, the board's share added back
-        out[crushed] = rigid
-        extra[crushed] = rigid_extra
-    return out, extra
+    the crush force F_c = K_L δ_c² is that layer impact.  One that does crushes the flutes: the board stays
+    flat at δ_c and carries the whole force to the floor, so the fruit goes on as on a rigid half-space, from
+    its own deflection and speed at F_c (the same first integral, walked on: the board's work K_L δ_c³/3 and
+    the viscous work before the crush are spent), and unloads alone: the crushed board gives nothing back.
+    Its pressure beyond F_c is the fruit's Hertz contact on the floor (the board no longer spreads it).
+    Reported for those rows: ``bottomed_out`` 1, the plastic work (the loop ∮F_T dδ) holding the board's
+    K_L δ_c³/3 (its flutes collapse for good), and as the fruit's share the rest of the absorbed energy (its
+    own plastic work and the viscous work of its law, as before the change to this walk-on model).  Without damping this is the rigid impact at
+    V' = √(V² − 2 K_L δ_c³/(3m)), as energy says.  Arguments as for ``plastic_characteristics``."""
+    return plastic_characteristics(mass, velocity, stiffness, radius, contact_modulus, yield_pressure,
+                                   layer_stiffness, crush_depth, damping_factor, crushes=True)
 
 
 __all__ = ["N_PLASTIC", "PLASTIC_COLUMNS", "crushing_characteristics", "plastic_characteristics", "plastic_curves",

@@ -5,7 +5,7 @@ any force family of ``engine.forces``, and shows its discretisation error.
 The state is (δ, δ̇) with m δ̈ = -F(δ, δ̇), δ(0) = 0, δ̇(0) = v0.
 
 Read-off convention (the paper's, see docs/paper.md): the peak force, its time
-and the maximum deflection are the largest grid samples; the end of contact
+and the maximum deflection are the largest grid samples, first touch included; the end of contact
 is located inside the last step by cubic Hermite interpolation of δ(t) (or
 linear interpolation of F(t) when a clamped force vanishes first), and the
 exit velocity is the Hermite interpolant's slope there.
@@ -94,8 +94,12 @@ def rk4_impact(family, params, clamp, mass, velocity, radius, step, max_steps, s
     d = 0.0
     v = velocity
     t = 0.0
-    force = 0.0
-    peak_force = 0.0
+    # the first grid sample is first touch: F(0, V), zero for the Hertz laws but b V for Kelvin–Voigt's dashpot,
+    # whose peak may be there (t_c = 0)
+    force = contact_force(family, params, 0.0, velocity, False)
+    if clamp and not force > 0.0:
+        force = 0.0
+    peak_force = force
     time_to_peak = 0.0
     max_deflection = 0.0
     time_to_max = 0.0
@@ -104,7 +108,7 @@ def rk4_impact(family, params, clamp, mass, velocity, radius, step, max_steps, s
         t_arr[0] = 0.0
         d_arr[0] = 0.0
         v_arr[0] = velocity
-        f_arr[0] = 0.0
+        f_arr[0] = force
     for k in range(1, max_steps + 1):
         d_new, v_new = rk4_step(family, params, clamp, mass, d, v, step)
         t_new = k * step

@@ -28,7 +28,7 @@ from fruitimpact.library import catalogue as library
 from fruitimpact.physics import hertz as contact
 from fruitimpact.physics.hertz import hertz_contact_duration
 from fruitimpact.physics.constants import STANDARD_GRAVITY
-from fruitimpact.engine.codes import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS
+from fruitimpact.engine.codes import CHARACTERISTIC_COLUMNS, COLUMN, CONTACT_RADIUS, N_CHARACTERISTICS, TIME_TO_PEAK
 from fruitimpact.impact.inputs import InputColumns, read_columns
 from fruitimpact.physics import DAMPING_LAWS
 from fruitimpact.impact.registries import REGISTRIES
@@ -453,6 +453,13 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                    f"(δ_max/R > {HERTZ_RANGE ** 2:g}), where the paraboloid that Hertz puts in "
                                    f"place of the fruit is more than 4 % off; treat the figures as an estimate")
 
+    # a peak at first touch (Kelvin–Voigt's dashpot force b V above all the spring gives later): C = F_max/t_c
+    # and C* are undefined, said rather than left as NaN without a word (docs/models.md)
+    at_touch = (status != INVALID) & (out[:, TIME_TO_PEAK] == 0.0)
+    if at_touch.any():
+        warnings.add(at_touch, "firmness C = F_max/t_c and C* = F_max/t_c² are undefined: the peak force is at "
+                               "first touch (t_c = 0), the dashpot's force b·V above any force the spring reaches "
+                               "later (heavy damping)")
     done = status != INVALID
     _range_warnings(warnings, out, plastic_block, layer, thickness, used["surface_thickness"], radius, done, detail,
                     crushing)
@@ -493,7 +500,7 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                                                                         velocity[idx])
     arguments = dict(mass=mass, velocity=velocity, stiffness=stiffness, radius=radius,
                      contact_modulus=contact_modulus, yield_pressure=yield_pressure, layer_stiffness=layer_stiffness,
-                     thickness=thickness, damping_factor=factor)
+                     thickness=bottoming, damping_factor=factor, crushes=crushing.astype(float))
     return Evaluation(rows, columns, status, messages, warnings, closed, out, plastic, arguments, plastic_block)
 
 

@@ -268,7 +268,8 @@ def impact(fruit, surface, keywords: dict, curve_points: int):
         "damage": damage, "names": dict(names), "damage_inputs": damage_inputs, "plastic": False,
         "plastic_arguments": {"mass": mass, "velocity": velocity, "stiffness": stiffness, "radius": radius,
                               "contact_modulus": contact_modulus, "yield_pressure": yield_pressure,
-                              "layer_stiffness": math.inf, "thickness": math.inf, "damping_factor": factor}})
+                              "layer_stiffness": math.inf, "thickness": math.inf, "damping_factor": factor,
+                              "crushes": 0.0}})
 
 
 __all__ = ["NUMERIC", "TEXT", "impact"]

@@ -8,8 +8,8 @@ Every computed impact is judged here before anyone sees it:
   the solver's tolerance (energy created, or a rebound into the surface);
 * ``inaccurate``: a physical result whose numerical error, measured against
   the accurate solver, exceeds what the method promises (RK4 at a coarse
-  step: 1 % on e, T, δ_max, F_max); the message says by how much and which
-  step would do;
+  step: 0.01 on e, absolute since e may be near 0; 1 % on T, δ_max, F_max);
+  the message says by how much and which step would do;
 * ``invalid``: refused input (set by validation, before any computing);
 * ``ok``: everything else.  Round-off may not create energy: a restitution
   that exceeds 1 by less than the solver's tolerance (an undamped impact

@@ -121,7 +121,8 @@ register(DampingLaw(
     source=("R. G. Herbert, D. C. McWhannell, Shape and frequency composition of pulses from an impact pair, "
             "J. Eng. Ind. 99 (1977) 513-518; χ = 6(1-e)/((2e-1)² + 3); " + _MACHADO + "."),
     published=laws.herbert_mcwhannell,
-    validity="tends to Hunt-Crossley as e → 1; χ stays finite at e = 0, so achieved e never falls below 0.49"))
+    validity=("tends to Hunt-Crossley as e → 1; χ stays finite at e = 0, so achieved e never falls below 0.487 "
+              "(χ(0) = 1.5)")))
 register(DampingLaw(
     name="lee-wang", title="Lee & Wang 1983",
     source=("T. W. Lee, A. C. Wang, On the dynamics of intermittent-motion mechanisms, part 1, J. Mech. Transm. "
@@ -150,7 +151,8 @@ register(DampingLaw(
     source=("Q. Zhiying, L. Qishao, Analysis of impact process based on restitution coefficient, J. Dyn. Control "
             "4 (2006) 294-298; χ = 3(1 - e²) exp(2(1 - e))/4; " + _MACHADO + "."),
     published=laws.zhiying_qishao,
-    validity="good for e ≈ 0.4-0.9; χ finite at e = 0, so achieved e never falls below 0.18"))
+    validity=("good for e ≈ 0.4-0.9; χ finite at e = 0, so achieved e never falls below 0.178 "
+              "(χ(0) = 0.75 exp 2 ≈ 5.54)")))
 register(DampingLaw(
     name="flores", title="Flores, Machado, Silva & Martins 2011",
     source=("P. Flores, M. Machado, M. T. Silva, J. M. Martins, On the continuous contact force models for soft "
