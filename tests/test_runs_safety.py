@@ -398,3 +398,55 @@ def test_a_step_that_some_fruit_of_a_lot_meet_leaves_the_others_to_their_rows(cl
                  "--method", "rk4", "--step", f"{duration / 20:.6g}", "--json")
     report = json.loads(out)
     assert 100 < report["ok"] < 300 and report["ok"] + report["invalid"] == 400, report["statuses"]
+
+
+def test_the_writer_thread_imports_nothing(tmp_path):
+    """A Ctrl-C half a second into a batch hung for good in 8 of 28 tries (an attack): the KeyboardInterrupt
+    landed inside an import of the main thread (Arrow imports pandas on its first conversion), which kept
+    CPython's import lock, and the interrupted run waited for the writer thread, itself waiting for that lock in
+    ``import pyarrow.parquet``.  The writer's modules are now imported before it starts: in a fresh process, no
+    import happens in the writer thread (an import hook records each module found, by thread)."""
+    script = tmp_path / "run.py"
+    (tmp_path / "in.csv").write_text("mass,velocity\n" + "".join(f"0.1{k % 10},1.{k % 7}\n" for k in range(3000)))
+    script.write_text(
+        "import sys, threading\n"
+        "found = []\n"
+        "class Spy:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        found.append((threading.current_thread().name, name))\n"
+        "        return None\n"
+        "sys.meta_path.insert(0, Spy())\n"
+        "from fruitimpact.cli import main\n"
+        "code = main(['batch', 'in.csv', '-o', 'out.parquet', '--chunk-size', '1000'])\n"
+        "print(code, sorted({n for t, n in found if t.startswith('fruitimpact-writer')}))\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "0 []", done.stdout[-2000:]
+
+
+@pytest.mark.parametrize("stop_at", [0, 2])
+def test_ctrl_c_keeps_the_work_folder_only_with_a_chunk_in_it(tmp_path, cli, monkeypatch, stop_at):
+    """A Ctrl-C before any chunk was stored left OUT.parts (lock file, marker, empty manifest) and said "completed
+    chunks are kept": the next, different job to that output was then refused as "another job's parts" (an
+    attack).  Now the folder goes when nothing is in it, and the message says so; with two chunks stored it stays,
+    and the same command resumes them."""
+    source = velocities_csv(tmp_path / "in.csv")
+    real = runs.chunks.write_part
+
+    def interrupted(workdir, index, table):
+        if index >= stop_at:
+            raise KeyboardInterrupt
+        return real(workdir, index, table)
+
+    monkeypatch.setattr(runs.chunks, "write_part", interrupted)
+    status, out, err = cli.run("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
+    assert status == 130 and out == ""
+    assert not (tmp_path / "out.parquet").exists()
+    parts = tmp_path / "out.parquet.parts"
+    if stop_at == 0:
+        assert err.strip().endswith("interrupted; no chunk was complete: nothing kept") and not parts.exists()
+    else:
+        assert "completed chunks are kept in" in err and parts.exists()
+    monkeypatch.undo()
+    resumed = "2 chunks resumed" in cli.ok("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
+    assert resumed == (stop_at == 2)

@@ -64,8 +64,11 @@ def _run(args, plan, keep_columns=(), percentiles=None):
     except runs.RunError as exc:
         raise UsageError(str(exc)) from None
     except KeyboardInterrupt:
-        print(f"{PROG} {args.command}: interrupted; completed chunks are kept in {checked[1]}: "
-              f"run the same command again to resume", file=sys.stderr)
+        from pathlib import Path
+
+        kept = (f"completed chunks are kept in {checked[1]}: run the same command again to resume"
+                if checked[1] is not None and Path(checked[1]).exists() else "no chunk was complete: nothing kept")
+        print(f"{PROG} {args.command}: interrupted; {kept}", file=sys.stderr)
         return None
 
 

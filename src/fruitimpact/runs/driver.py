@@ -205,9 +205,10 @@ def execute(plan, output=None, *, engine=None, workdir=None, fresh: bool = False
         try:
             summary = _run(plan, work, output, engine, percentiles, keep_columns)
         except BaseException as exc:
-            if isinstance(exc, Exception) and not _kept(work):
-                # failed before any chunk was kept (a Dask scheduler that does not answer): nothing to resume, so
-                # the folder's own files go, and the folder if this run made it; an interrupt keeps it as it says
+            if not _kept(work):
+                # failed or interrupted before any chunk was kept (a Dask scheduler that does not answer, a Ctrl-C
+                # in the first chunk): nothing to resume, so the folder's own files go, and the folder if this run
+                # made it (kept, it refused the next, different job to that output as "another job's parts")
                 work.remove()
             else:
                 work.release()
