@@ -204,7 +204,7 @@ def execute(plan, output=None, *, engine=None, workdir=None, fresh: bool = False
         work = WorkDir.open(workdir, plan.fingerprint(), plan.identity(), fresh=fresh, spare=output)
         try:
             summary = _run(plan, work, output, engine, percentiles, keep_columns)
-        except BaseException as exc:
+        except BaseException:
             if not _kept(work):
                 # failed or interrupted before any chunk was kept (a Dask scheduler that does not answer, a Ctrl-C
                 # in the first chunk): nothing to resume, so the folder's own files go, and the folder if this run
