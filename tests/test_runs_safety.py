@@ -14,6 +14,8 @@ import sys
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from fruitimpact import runs
@@ -450,3 +452,34 @@ def test_ctrl_c_keeps_the_work_folder_only_with_a_chunk_in_it(tmp_path, cli, mon
     monkeypatch.undo()
     resumed = "2 chunks resumed" in cli.ok("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 7)
     assert resumed == (stop_at == 2)
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda: pa.table({"mass": [{"a": 1}]}), "column 'mass' of 'm.parquet' holds struct<a: int64>"),  # a traceback
+    (lambda: pa.table({"mass": [True, False]}), "holds bool"),  # was read as 1 kg and 0 kg
+    (lambda: pa.table({"mass": pa.array([0], pa.timestamp("us"))}), "holds timestamp[us]"),  # was 1.58e15 kg
+])
+def test_a_parquet_sample_holds_numbers_or_text(tmp_path, cli, monkeypatch, make, words):
+    """sample(FILE.parquet:COLUMN) takes numbers or text with units; another type is no measurement (an attack
+    found a structure crashing with a traceback, and true/false and dates read as masses)."""
+    monkeypatch.chdir(tmp_path)
+    pq.write_table(make(), tmp_path / "m.parquet")
+    assert words in cli.error("population", "-n", "10", "--mass", "sample(m.parquet:mass)")
+
+
+def test_sample_files_read_as_written(tmp_path, cli, monkeypatch):
+    """A CSV sample: a header given twice is refused (which column was meant is a guess; batch refuses it too);
+    blank lines before the header are skipped; "NAN" is a missing value like "NaN" and "nan" (it made the file be
+    refused).  A Parquet sample's nulls are missing values, its text cells may carry units, its integers are
+    numbers: the members are those values and no other (the sample's n and values are checked)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "twice.csv").write_text("mass,mass\n0.1,0.2\n")
+    assert "sample: 'twice.csv': column 'mass' is given twice" in cli.error(
+        "population", "-n", "10", "--mass", "sample(twice.csv:mass)")
+    (tmp_path / "blank.csv").write_text("\n\nmass\n0.1\nNAN\nnan\n120g\n")
+    pq.write_table(pa.table({"mass": ["115g", None, "0.1"]}), tmp_path / "text.parquet")
+    for name, values in (("blank.csv", [0.1, 0.12]), ("text.parquet", [0.1, 0.115])):
+        report = cli.json("population", "-n", "200", "--mass", f"sample({name}:mass)", "--no-spreads", "-o",
+                          f"{name}.parquet")
+        assert report["inputs"]["mass"] == f"sample({name}:mass, n=2)" and report["ok"] == 200
+        assert sorted(set(np.round(pd.read_parquet(f"{name}.parquet")["mass"], 12))) == values
