@@ -327,7 +327,8 @@ def test_a_cell_that_is_not_utf8_or_a_column_of_another_type_is_a_bad_row_not_a_
     assert out["mass"].isna().tolist() == [False, True, True, False]  # the unread rows used no input
     numbers = tmp_path / "model.parquet"
     pq.write_table(pa.table({"model": [1, 2], "velocity": [1.0, 1.0]}), numbers)
-    cli.ok("batch", numbers, "-o", tmp_path / "m.csv")
+    status, _, err = cli.run("batch", numbers, "-o", tmp_path / "m.csv")  # written, every row said why; exit 1
+    assert status == 1 and "no row is ok (2 rows: 0 ok, 2 invalid, 0 failed)" in err
     assert pd.read_csv(tmp_path / "m.csv")["message"].str.startswith("model must be one of").all()
     nested = tmp_path / "nested.parquet"
     pq.write_table(pa.table({"mass": [[1.0], [2.0]]}), nested)
@@ -381,10 +382,27 @@ def test_a_step_too_coarse_for_every_fruit_of_a_lot_or_grid_is_refused_before_wo
     # refused for every member is a usage error (each run used to print "0 ok, N invalid" and exit 0)
     line = cli.error("population", "-n", "500", "--method", "rk4", "--step", "1s")
     assert line.startswith("fruitimpact population: error: argument --step: step must be at most 1/20 of the contact")
-    assert line.endswith("every one of the lot's first 500 fruit is refused for it")
+    assert line.endswith("every one of the lot's 500 fruit is refused for it")
     line = cli.error("sweep", "--velocity", "0.5:1:3", "-o", tmp_path / "a.csv", "--method", "rk4", "--step", "1s")
     assert line.endswith("every one of the grid's 3 points is refused for it")
     assert not (tmp_path / "a.csv").exists() and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("argv, line", [
+    # a mass drawn below zero, a lot or grid too large to validate whole before the run: computed, nothing ok
+    (["population", "-n", "5000", "--method", "rk4", "--step", "1s"],
+     "fruitimpact population: no row is ok (5000 rows: 0 ok, 5000 invalid, 0 failed)"),
+    (["sweep", "--mass", "0.1:0.2:100", "--velocity", "0.5:1:100", "--method", "rk4", "--step", "1s", "-o", "g.csv"],
+     "fruitimpact sweep: no row is ok (10000 rows: 0 ok, 10000 invalid, 0 failed); each row's message in g.csv"),
+])
+def test_a_run_with_no_row_ok_exits_1_and_says_so(tmp_path, cli, monkeypatch, argv, line):
+    """A run whose every row is refused or failed computed nothing a user could take: it exited 0 and printed a
+    table of NaN (an attack).  A lot or grid of at most 4,096 is validated whole before the run (usage error,
+    exit 2, test above); a larger one is computed (one runnable fruit among them must run) and exits 1 with one
+    line on stderr."""
+    monkeypatch.chdir(tmp_path)
+    status, _, err = cli.run(*argv)
+    assert status == 1 and err.strip().splitlines()[-1].startswith(line), (status, err)
 
 
 def test_a_step_that_some_fruit_of_a_lot_meet_leaves_the_others_to_their_rows(cli):

@@ -72,6 +72,16 @@ def _run(args, plan, keep_columns=(), percentiles=None):
         return None
 
 
+def _outcome(command: str, summary) -> int:
+    """The exit status of a finished run: 0, or 1 with one line on stderr when no row is ok (every row refused or
+    failed: nothing was computed that a user could take, though each row's message says why)."""
+    if summary.rows and not summary.ok:
+        where = f"; each row's message in {summary.output} says why" if summary.output else ""
+        print(f"{PROG} {command}: no row is ok ({_status_line(summary)}){where}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _status_line(summary) -> str:
     """``N rows: a ok, b invalid, c failed`` and any other status evaluate reported."""
     counts = {"ok": summary.ok, "invalid": summary.invalid, "failed": summary.failed}
@@ -90,7 +100,7 @@ def cmd_batch(args) -> int:
     if summary is None:
         return 130
     print(f"batch: {_status_line(summary)}; written to {summary.output}")
-    return 0
+    return _outcome("batch", summary)
 
 
 def cmd_sweep(args) -> int:
@@ -128,7 +138,7 @@ def cmd_sweep(args) -> int:
             return 1
         _save("--plot", runs.sweep_figure(plan.source, values, name), args.plot)
         print(f"figure written to {args.plot}")
-    return 0
+    return _outcome("sweep", summary)
 
 
 def _save(option: str, fig, path) -> None:
@@ -189,7 +199,7 @@ def cmd_population(args) -> int:
         for what, path in (("rows", summary.output), ("histograms", args.hist)):
             if path:
                 print(f"{what} written to {path}")
-    return 0
+    return _outcome("population", summary)
 
 
 def _input_help(quantity) -> str:

@@ -736,11 +736,12 @@ def refuse_constants(constants: dict, text: dict, given=()) -> None:
 
 
 def refuse_lot(columns, given, what: str) -> None:
-    """Refuse, before a run, a constant of the user's that a bound depending on other inputs refuses for every
-    member of ``columns`` (the first members of a lot, or a whole grid): a step too coarse for rk4 for every fruit,
-    which :func:`refuse_constants` leaves to the rows because a lot's other fruit may meet it.  Refused only when
-    every row is refused, for one and the same input, and that input is in ``given`` (the inputs the user set to
-    one value); ``InputError`` with the rows' message and ``what`` they are ("the lot's first 4,096 fruit")."""
+    """Refuse, before a run, an input of the user's that every row of ``columns`` (a whole lot or grid, as it will
+    be computed) is refused for: a step too coarse for rk4 for every fruit (which :func:`refuse_constants` leaves to
+    the rows, since another fruit may meet it), a mass drawn from a range below zero.  Refused only when every row
+    is refused, for one and the same input, and that input is in ``given`` (the inputs the user gave: constants,
+    distributions, swept axes); ``InputError`` with the rows' message and ``what`` they are ("the lot's 500
+    fruit")."""
     messages = validate(columns)
     rows = len(messages.codes)
     if rows == 0 or not messages.flagged.all() or len(np.unique(messages.codes)) != 1:

@@ -28,7 +28,7 @@ _LEGACY_STREAMS = ("mass", "diameter", "modulus", "poisson", "stiffness", "veloc
                    "alpha", "step")
 #: Random stream of the percentile-sample keys.
 KEY_STREAM = 1000
-#: Members of a lot validated before a run (``read_lot``): enough to see the lot's spread, a few ms of checks.
+#: The largest lot or grid validated whole before a run (``read_lot``, ``runs.tasks.sweep_plan``): a few ms.
 PILOT_ROWS = 4096
 
 
@@ -156,13 +156,14 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     if bases:
         extra, described = _one_bruise_basis(extra, described, dict(bases), distributions, text)
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
-    if not excluded and not fixed:
-        # a bound that depends on the drawn fruit (rk4's step) is judged on the lot's first members, as drawn;
-        # not where each point or axis sets inputs later (the members' rows are not yet what will be computed)
+    if not excluded and not fixed and rows <= PILOT_ROWS:
+        # a lot small enough to validate whole before the run (a few ms): an input of the user's (a constant or a
+        # distribution) that every member fails, such as a step too coarse for rk4 or a mass drawn below zero, is
+        # a usage error; a larger lot is left to its rows (one runnable fruit among them must run), and a run with
+        # no row ok says so in its exit status.  Not where each point or axis sets inputs later.
         from fruitimpact.impact.evaluation import refuse_lot
 
-        pilot = min(rows, PILOT_ROWS)
-        refuse_lot(source.inputs(0, pilot, None)[0], list(constants) + list(text), f"the lot's first {pilot:,} fruit")
+        refuse_lot(source.inputs(0, rows, None)[0], given, f"the lot's {rows:,} fruit")
     return source, text, tuple(described)
 
 

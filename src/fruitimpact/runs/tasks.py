@@ -216,7 +216,7 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
     if points <= PILOT_ROWS:  # a bound that depends on the swept inputs (rk4's step), judged on the whole grid
         from fruitimpact.impact.evaluation import refuse_lot
 
-        refuse_lot(grid.inputs(0, points, None)[0], list(constants) + list(text), f"the grid's {points:,} points")
+        refuse_lot(grid.inputs(0, points, None)[0], list(axes_text), f"the grid's {points:,} points")
     return Plan("sweep", grid, chunk_size, write_rows=write_rows), tuple(axes)
 
 
