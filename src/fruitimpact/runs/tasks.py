@@ -106,6 +106,12 @@ def batch_plan(input, output=None, chunk_size=CHUNK_ROWS) -> Plan:
     from fruitimpact.runs.sources import TableSource
 
     chunk_size = read_count("chunk_size", chunk_size, 1, MAX_CHUNK_ROWS)
+    if output:  # before the input is read and hashed (1 s per GB): a bad output is answered at once
+        from fruitimpact.impact.outputs import TABLE_FORMATS, check_output
+
+        check_output(output, "-o/--output", TABLE_FORMATS)
+        if Path(input).exists() and Path(output).exists() and Path(output).samefile(input):
+            raise InputError("output must differ from the input file", "output")
     try:
         source = TableSource.open(input)
     except ValueError as exc:
