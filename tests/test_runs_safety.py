@@ -517,3 +517,18 @@ def test_a_bad_batch_output_is_refused_before_the_input_is_read(tmp_path, cli, m
 
     monkeypatch.setattr(runs.sources.TableSource, "open", never)
     assert words in cli.error("batch", "in.csv", "-o", output)
+
+
+def test_an_implausible_value_in_a_run_is_said_once(tmp_path, cli, monkeypatch):
+    """The brief: an implausible but legal value (a 180 kg fruit) gets one warning.  simulate said it; population,
+    sweep and batch computed it without a word (an attack): each warning the rows carry is now said once on
+    stderr with how many rows carry it, and listed in population's JSON."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "b.csv").write_text("mass,velocity\n180,1\n0.1,1\n")
+    status, _, err = cli.run("batch", "b.csv", "-o", "b.parquet")
+    lines = [line for line in err.splitlines() if "mass is outside the plausible range" in line]
+    assert status == 0 and lines == ["fruitimpact batch: warning: 1 of 2 rows: mass is outside the plausible range "
+                                     "for fruit, [0.001, 20] kg; a plain number is read in kg"]
+    report = cli.json("population", "-n", "50", "--mass", "180kg")
+    assert "50 of 50 rows: mass is outside the plausible range for fruit, [0.001, 20] kg; a plain number is read " \
+           "in kg" in report["warnings"]

@@ -74,7 +74,11 @@ def _run(args, plan, keep_columns=(), percentiles=None):
 
 def _outcome(command: str, summary) -> int:
     """The exit status of a finished run: 0, or 1 with one line on stderr when no row is ok (every row refused or
-    failed: nothing was computed that a user could take, though each row's message says why)."""
+    failed: nothing was computed that a user could take, though each row's message says why).  Each warning the
+    rows carry is said once on stderr, with how many rows carry it (a 180 kg fruit in a lot, as ``simulate`` says
+    it for one)."""
+    for line in summary.warning_lines():
+        print(f"{PROG} {command}: warning: {line}", file=sys.stderr)
     if summary.rows and not summary.ok:
         where = f"; each row's message in {summary.output} says why" if summary.output else ""
         print(f"{PROG} {command}: no row is ok ({_status_line(summary)}){where}", file=sys.stderr)

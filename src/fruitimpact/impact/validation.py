@@ -314,6 +314,11 @@ class WarningBook:
         mask = int(self.masks[row])
         return [text for bit, text in enumerate(self.texts) if mask >> bit & 1]
 
+    def counts(self) -> dict[str, int]:
+        """Rows carrying each warning, by its text."""
+        return {text: int(np.count_nonzero(self.masks & (np.int64(1) << np.int64(bit))))
+                for bit, text in enumerate(self.texts)}
+
     def categories(self) -> tuple[np.ndarray, list[str]]:
         """(codes, categories): each row's joined warning text as a categorical."""
         masks = self.masks

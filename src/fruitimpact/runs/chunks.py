@@ -95,7 +95,7 @@ def compute_chunk(plan, index: int, payload) -> dict:
     inputs, errors = plan.source.inputs(start, stop, payload)
     result = evaluate_rows(inputs, start, errors)
     record = {"chunk": index, "start": start, "rows": result.rows, "statuses": result.status_counts(),
-              "part": None, "summary": None}
+              "warnings": result.warnings.counts(), "part": None, "summary": None}
     return {"record": record, "summary": summarise(plan, result, start),
             "table": result.table(start) if plan.write_rows else None}
 

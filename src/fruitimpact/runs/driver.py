@@ -280,4 +280,4 @@ def _run(plan, work: WorkDir, output, engine, percentiles, keep_columns) -> RunS
     return RunSummary(plan.kind, rows, ok, statuses.get("invalid", 0), statuses.get("failed", 0),
                       None if not write_rows else str(output), resumed, combined.get("statistics", {}),
                       combined.get("thresholds", []), combined.get("percentiles", {}), combined.get("sample"),
-                      columns, statuses)
+                      columns, statuses, add_statuses((records[i] for i in sorted(records)), "warnings"))

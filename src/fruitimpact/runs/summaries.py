@@ -41,6 +41,8 @@ class RunSummary:
         Columns read back whole for a figure (a sweep's plotted characteristic).
     statuses : dict
         Rows per status name.
+    warnings : dict
+        Rows per warning text (an implausible value, a result to be read with care).
     details : dict
         What the run was asked: a population's ``seed``, ``inputs`` (each drawn input's distribution) and
         ``spreads``.
@@ -59,22 +61,29 @@ class RunSummary:
     sample: np.ndarray | None = None  # the percentile sample, one column per statistic
     columns: dict = field(default_factory=dict)  # columns read back for figures (keep_columns)
     statuses: dict = field(default_factory=dict)  # rows per status, every status evaluate reported
+    warnings: dict = field(default_factory=dict)  # rows per warning text
     details: dict = field(default_factory=dict)  # what the run was asked (a population's seed, inputs, spreads)
+
+    def warning_lines(self) -> list[str]:
+        """Each warning the rows carry, once, with how many rows carry it."""
+        return [f"{count:,} of {self.rows:,} rows: {text}" for text, count in self.warnings.items()]
 
     def to_dict(self) -> dict:
         """The summary as JSON-ready values (``fruitimpact population --json``)."""
         return {"kind": self.kind, "rows": self.rows, "ok": self.ok, "invalid": self.invalid, "failed": self.failed,
-                "statuses": self.statuses, "output": self.output, "resumed_chunks": self.resumed_chunks,
+                "statuses": self.statuses, "warnings": self.warning_lines(), "output": self.output,
+                "resumed_chunks": self.resumed_chunks,
                 "percentile_method": self.percentiles, "statistics": self.statistics, "thresholds": self.thresholds,
                 **self.details}
 
 
-def add_statuses(records) -> dict[str, int]:
-    """Rows per status over the chunk ``records``."""
+def add_statuses(records, key: str = "statuses") -> dict[str, int]:
+    """Rows per status (or per warning text, ``key="warnings"``) over the chunk ``records`` (a record of an earlier
+    version without warnings counts none)."""
     total: dict[str, int] = {}
     for record in records:
-        for status, count in record["statuses"].items():
-            total[status] = total.get(status, 0) + int(count)
+        for name, count in record.get(key, {}).items():
+            total[name] = total.get(name, 0) + int(count)
     return total
 
 
