@@ -892,3 +892,25 @@ def test_a_tdms_file_cut_short_is_read_with_one_warning(tmp_path):
     frame = fi.analyze(cut)
     assert frame.attrs["warnings"] == [lines[0].split(f"{cut.name}: ", 1)[1]]
     assert fi.analyze(whole).attrs["warnings"] == []
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda p: np.save(p, np.r_[0.0, np.nan, 1.0]), "sample 1 of lane 'lane0' is nan"),
+    (lambda p: np.save(p, np.zeros((3, 1000))), "1000 lanes (an array of 3 samples × 1000 lanes), at most 256"),
+])
+def test_a_bad_npy_recording_is_refused_before_any_work(tmp_path, script, make, words):
+    """A NaN in the first samples of a .npy (or raw float32) recording was met while streaming: the table's header
+    was printed, numba loaded, and the refusal came at 0.8 s; a 3 × 1000 array (lanes for samples) was refused as
+    "lanes must be an integer in [1, 256]; got 1000", naming no argument (an attack).  Both are read when the
+    file is opened, as a CSV's first rows are: one line, exit 2, nothing on stdout."""
+    path = tmp_path / "rec.npy"
+    make(path)
+    done = script("analyze", str(path), "--rate", "20000", cwd=tmp_path)
+    assert done.returncode == 2 and done.stdout == "" and words in done.stderr and len(done.stderr.splitlines()) == 1
+
+
+def test_a_rate_too_low_for_the_detector_names_the_rate(tmp_path, script):
+    """At 100 Hz the detector's 0.5 ms windows have no sample: the refusal named "offset_hold", a setting no
+    option of the command sets (an attack); it is the rate's."""
+    done = script("stream", "--rate", "100", cwd=tmp_path, input="")
+    assert done.returncode == 2 and "argument --rate: the sample rate is too low for the detector" in done.stderr

@@ -47,6 +47,8 @@ def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: 
 _SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hum", "hum_q": "--hum",
                     "lowpass_cutoff": "--lowpass", "clip_low": "--clip", "clip_high": "--clip",
                     "max_flight": "--rebound-window", "pitch": "--pitch/--fruit-rate"}
+#: The detector's windows, which no option sets: an error about one of them is about the rate.
+_WINDOWS = ("offset_hold", "min_duration", "max_duration", "pre_trigger", "post_trigger", "warmup")
 
 
 def _setting_error(exc: ValueError) -> InputError:
@@ -54,7 +56,10 @@ def _setting_error(exc: ValueError) -> InputError:
     if isinstance(exc, InputError) and exc.argument is not None:
         return exc  # it names its input already
     text = str(exc)
-    option = _SETTING_OPTIONS.get(text.split(" ", 1)[0])
+    name = text.split(" ", 1)[0]
+    if name in _WINDOWS:  # the detector's own windows, no option of the command: the rate is too low for them
+        return _refusal("--rate", f"the sample rate is too low for the detector: its {text}")
+    option = _SETTING_OPTIONS.get(name)
     return _refusal(option, text) if option else InputError(text)
 
 

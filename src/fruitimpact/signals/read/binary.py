@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from fruitimpact.signals.read.common import BLOCK_SAMPLES, RecordingSource, check_finite, error, need_rate, open_file, read_exactly, select
+from fruitimpact.signals.settings import MAX_LANES
 
 
 def open_npy(path: Path, rate, column) -> RecordingSource:
@@ -60,8 +61,14 @@ def open_f32(path: Path, rate, column, lanes: int) -> RecordingSource:
 def _source(path, kind, rate, column, offset, dtype, rows, width, fortran) -> RecordingSource:
     names = [f"lane{k}" for k in range(width)]
     selected = select(path, names, column)
+    if len(selected) > MAX_LANES:
+        raise error(path, f"{len(selected)} lanes (an array of {rows} samples × {width} lanes), at most {MAX_LANES}: "
+                          f"a recording is samples × lanes (transposed?), or choose one lane (--column, column=)")
     indices = [names.index(name) for name in selected]
     blocks = partial(_blocks, path, offset, dtype, rows, width, fortran, indices, tuple(selected))
+    first = blocks(0)
+    next(first)  # the first block's samples checked (finite) before any work, as a CSV's first rows are
+    first.close()
     return RecordingSource(source=str(path), format=kind, rate=rate, lane_names=tuple(selected), samples=rows,
                            _blocks=blocks)
 
