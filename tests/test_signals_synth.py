@@ -389,3 +389,18 @@ def test_population_refuses_a_spread_whose_draws_overflow(name):
 ])
 def test_synth_integer_options_are_named_with_their_range(cli, tmp_path, argv, expected):
     assert cli.error("synth", "-o", tmp_path / "r.csv", *argv) == f"fruitimpact synth: error: {expected}"
+
+
+def test_synth_truth_names_its_recording_by_checksum(cli, tmp_path):
+    """The recording and its truth are two files, each written atomically; a run killed between them left a new
+    recording beside an earlier run's truth, and nothing told them apart (an attack).  The truth now carries the
+    recording's SHA-256 (hashlib over the file as written): an earlier truth does not match a new recording."""
+    import hashlib
+    import json
+
+    out = tmp_path / "rec.csv"
+    cli.ok("synth", "-o", out, "--count", "3", "--seed", "1")
+    first = json.loads((tmp_path / "rec.truth.json").read_text())
+    assert first["recording"] == {"file": "rec.csv", "sha256": hashlib.sha256(out.read_bytes()).hexdigest()}
+    cli.ok("synth", "-o", out, "--count", "3", "--seed", "2")
+    assert first["recording"]["sha256"] != hashlib.sha256(out.read_bytes()).hexdigest()

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from pathlib import Path
 
 from fruitimpact.cli.common import PROG, UsageError, _library_call, check_outputs, dump_json, read_option_count
 from fruitimpact.impact.validation import conflict_message
@@ -348,6 +349,15 @@ def cmd_synth(args) -> int:
         lanes=int(lanes), seed=sensor_kwargs["seed"] + 1)
     recording, truth = _library_call(synthesize, sensor, population, lanes=int(lanes))
     path = _library_call(write_recording, recording, args.output, fmt)
+    # the truth names its recording by checksum: a run stopped between the two files (each written atomically)
+    # leaves a new recording beside an earlier truth, which the checksum then shows not to be its own
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    truth["recording"] = {"file": Path(path).name, "sha256": digest.hexdigest()}
     truth_file = _library_call(write_truth, truth, truth_path(args.output))
     print(f"{len(truth['impacts'])} impacts ({sum(1 for i in truth['impacts'] if i['rebound'])} rebounds) in "
           f"{recording.duration:.4g} s at {recording.rate:g} Hz, {len(recording.lanes)} lane(s): written to {path}, "

@@ -117,6 +117,12 @@ def combine(summaries: list, plan, percentiles, ok: int) -> dict:
     """Merge chunk summaries (in chunk order) into statistics, threshold counts and percentiles
     of the ``ok`` rows."""
     moments = np.stack([s["moments"] for s in summaries])  # chunks × stats × (n, mean, m2, min, max)
+    with np.errstate(over="ignore", invalid="ignore"):  # values beyond double range (a 1e300 kg sample, warned
+        # of by the rows' own warning): their sd is NaN, said in the table rather than by NumPy on stderr
+        return _combine(summaries, moments, plan, percentiles, ok)
+
+
+def _combine(summaries: list, moments, plan, percentiles, ok: int) -> dict:
     sample = np.concatenate([s["sample"] for s in summaries]) if summaries else np.empty((0, len(plan.stats)))
     # numpy's partition releases the GIL: the columns' percentiles in parallel threads
     from concurrent.futures import ThreadPoolExecutor
