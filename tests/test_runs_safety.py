@@ -532,3 +532,38 @@ def test_an_implausible_value_in_a_run_is_said_once(tmp_path, cli, monkeypatch):
     report = cli.json("population", "-n", "50", "--mass", "180kg")
     assert "50 of 50 rows: mass is outside the plausible range for fruit, [0.001, 20] kg; a plain number is read " \
            "in kg" in report["warnings"]
+
+
+def test_ctrl_c_drops_a_large_chunk_being_written_instead_of_waiting(tmp_path, cli, monkeypatch):
+    """A Ctrl-C waited for the chunk being written: 7.8 s with --chunk-size 3000000 (an attack).  A chunk larger
+    than ``runs.abandon.WRITE_SLICE`` rows is written in slices, and an interrupted run's writer stops between two:
+    the part file's temporary is removed, the chunk is not kept, nothing else is left.  Here slices of 5 rows, and
+    the interrupt is raised once the writer has begun chunk 0 (so that it is caught mid-chunk)."""
+    import threading
+    import time
+
+    from fruitimpact.runs import abandon
+
+    source = velocities_csv(tmp_path / "in.csv")
+    monkeypatch.setattr(abandon, "WRITE_SLICE", 5)
+    started = threading.Event()
+    real_slices, real_compute = abandon.slices, runs.chunks.compute_chunk
+
+    def slow_slices(table):
+        for k, part in enumerate(real_slices(table)):
+            started.set()
+            time.sleep(0.05 if k else 0.0)  # the interrupt lands while this chunk is being written
+            yield part
+
+    def compute(plan, index, payload):
+        if index == 1:
+            assert started.wait(10)
+            raise KeyboardInterrupt
+        return real_compute(plan, index, payload)
+
+    monkeypatch.setattr(runs.workdir, "slices", slow_slices)
+    monkeypatch.setattr(runs.execute_module, "slices", slow_slices)
+    monkeypatch.setattr(runs.chunks, "compute_chunk", compute)
+    status, out, err = cli.run("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 25)
+    assert status == 130 and err.strip().endswith("interrupted; no chunk was complete: nothing kept"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.csv"]  # no part, no temporary, no output

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from fruitimpact.impact.outputs import TABLE_FORMATS, atomic_write, check_output, remove_stale_temporaries
+from fruitimpact.runs.abandon import slices
 from fruitimpact.runs.engines import InProcessEngine
 from fruitimpact.runs.locking import RunLock
 from fruitimpact.runs.plan import PERCENTILES, RunError
@@ -66,7 +67,8 @@ class TableWriter:
 
                 self.writer = pacsv.CSVWriter(self.path, table.schema,
                                               write_options=pacsv.WriteOptions(quoting_style="needed"))
-        self.writer.write_table(table)
+        for part in slices(table):  # an interrupted run's writer stops between slices (``runs.abandon``)
+            self.writer.write_table(part)
 
     def close(self) -> None:
         if self.writer is not None:

@@ -50,29 +50,43 @@ class InProcessEngine:
     into the output), so ``done`` runs in that thread, in chunk order, one chunk at a time.  pyarrow
     and hashlib release the GIL while they write and hash.  At most one chunk is in flight in each
     half; an error in the writer (a full disk) is raised here at the next chunk, and an interruption
-    waits for the chunk being written, which is then complete and kept."""
+    marks the writer, which drops the chunk it is writing at its next slice (``runs.abandon``): only chunks
+    whose files are complete are kept."""
 
     name = "inprocess"
 
     def run(self, plan, payloads, workdir: str, done) -> None:
+        import threading
         from concurrent.futures import ThreadPoolExecutor
+
+        from fruitimpact.runs import abandon
 
         from fruitimpact.runs.chunks import compute_chunk, store_chunk  # here: the CLI parser reads ENGINES cheaply
 
         preload_writer_modules()
 
+        writers = set()
+
         def store(computed):
+            writers.add(threading.get_ident())
             done(store_chunk(plan, computed, workdir, keep_rows=True))
 
         with ThreadPoolExecutor(1, thread_name_prefix="fruitimpact-writer") as writer:
-            writing = None
-            for index, payload in payloads:
-                computed = compute_chunk(plan, index, payload)
+            try:
+                writing = None
+                for index, payload in payloads:
+                    computed = compute_chunk(plan, index, payload)
+                    if writing is not None:
+                        writing.result()  # the previous chunk is stored (or its error raised) before the next
+                    writing = writer.submit(store, computed)
                 if writing is not None:
-                    writing.result()  # the previous chunk is stored (or its error raised) before the next starts
-                writing = writer.submit(store, computed)
-            if writing is not None:
-                writing.result()
+                    writing.result()
+            except KeyboardInterrupt:
+                abandon.mark(writers)  # the chunk being written is dropped at its next slice, not waited for
+                raise
+            finally:
+                writer.shutdown(wait=True)
+                abandon.unmark(writers)
 
 
 @dataclass(frozen=True)

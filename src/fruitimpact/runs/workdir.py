@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from fruitimpact.impact.outputs import temporary_path
+from fruitimpact.runs.abandon import slices
 from fruitimpact.runs.locking import RunLock
 from fruitimpact.runs.plan import WORK_FORMAT, RunError
 
@@ -101,7 +102,8 @@ def write_part(workdir, index: int, table) -> dict:
 
     def write(sink):
         with pa.ipc.new_file(sink, table.schema, options=options) as writer:
-            writer.write_table(table)
+            for part in slices(table):  # an interrupted run's writer stops between slices (``runs.abandon``)
+                writer.write_table(part)
 
     return _write_file(Path(workdir) / part_name(index), write)
 
