@@ -914,3 +914,19 @@ def test_a_rate_too_low_for_the_detector_names_the_rate(tmp_path, script):
     option of the command sets (an attack); it is the rate's."""
     done = script("stream", "--rate", "100", cwd=tmp_path, input="")
     assert done.returncode == 2 and "argument --rate: the sample rate is too low for the detector" in done.stderr
+
+
+def test_a_missing_sample_is_reported_where_it_is(tmp_path):
+    """A CSV recording with one sample missing at row 50,001: its step is twice the others, and it pulled the mean
+    interval off by 1e-5, so every interval failed the uniformity check and row 2 was named (an attack).  The
+    gross step is looked for first and named at its own row (50,001 of the file: line 50,002)."""
+    n = 100_000
+    t = np.arange(n) / 20_000.0
+    keep = np.ones(n, dtype=bool)
+    keep[50_000] = False
+    path = tmp_path / "gap.csv"
+    np.savetxt(path, np.c_[t[keep], np.zeros(n)[keep]], fmt="%.6f", delimiter=",", header="time [s],force [N]",
+               comments="")
+    with pytest.raises(ValueError, match=r"non-uniform sampling at row 50001 \(line 50002\): interval 0\.0001 s"):
+        for _ in read_recording(path).blocks():
+            pass

@@ -92,7 +92,7 @@ def read_exactly(handle, path, position: int, size: int) -> bytes:
 def need_rate(path, rate, why: str) -> float:
     """``rate`` [Hz], which the file cannot give (``why``): refused when None."""
     if rate is None:
-        raise error(path, f"rate is required: {why}; give rate= [Hz]", "rate")
+        raise error(path, f"rate is required: {why}; give the sample rate [Hz] (--rate; rate= in Python)", "rate")
     return rate
 
 

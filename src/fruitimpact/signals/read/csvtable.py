@@ -339,6 +339,14 @@ class _Clock:
                                    f"{float(times[i + 1])!r} s after {float(times[i])!r} s; time must increase "
                                    f"strictly")
         if uniform:
+            # a sample missing (or doubled) is a step far from the others: said where it is, before the small
+            # deviations it causes everywhere once it is in the mean interval (it was reported at row 2)
+            gross = np.flatnonzero(np.abs(steps - self.interval) > 0.5 * self.interval)
+            if gross.size:
+                i = int(gross[0])
+                raise error(self.path, f"non-uniform sampling at row {row0 + i + later + 1} (line "
+                                       f"{numbers[i + later]}): interval {steps[i]:.9g} s where the others are "
+                                       f"about {self.interval:.9g} s (a sample missing or repeated?)")
             slack = RATE_TOLERANCE * self.interval + 8.0 * np.finfo(float).eps * max(abs(self.first),
                                                                                       abs(float(times[-1])))
             bad = np.flatnonzero(np.abs(steps - self.interval) > slack)
@@ -347,7 +355,7 @@ class _Clock:
                 raise error(self.path, f"non-uniform sampling at row {row0 + i + later + 1} (line "
                                        f"{numbers[i + later]}): interval {steps[i]:.9g} s, mean interval "
                                        f"{self.interval:.9g} s (allowed: {RATE_TOLERANCE:g} relative; write the "
-                                       f"times with more digits, or drop the time column and give rate=)")
+                                       f"times with more digits, or drop the time column and give --rate)")
         self.previous = float(t[-1])
 
 
