@@ -241,9 +241,17 @@ def _solve_max_force(energy, p, guess):
 def _log_slope_of_pressure(F, p, yield_pressure):
     """ε = d ln p_T / d ln F of the centre pressure along loading (1/3 for Hertz, 0 once yielded)."""
     h = 1e-6
-    lo = _pressure_at(F * (1.0 - h), p, yield_pressure)[0]
-    hi = _pressure_at(F * (1.0 + h), p, yield_pressure)[0]
-    return (math.log(hi) - math.log(lo)) / (math.log1p(h) - math.log1p(-h))
+    low, high = F * (1.0 - h), F * (1.0 + h)
+    if p[CR_] > 0.0 and low <= p[FB_] < high:
+        # a crushed board's pressure jumps at F_b (it stops spreading the load): the difference is taken on F's
+        # own side of the jump, or the slope at the end of the piece below it is that of the jump
+        if F <= p[FB_]:
+            high = F
+        else:
+            low = F
+    lo = _pressure_at(low, p, yield_pressure)[0]
+    hi = _pressure_at(high, p, yield_pressure)[0]
+    return (math.log(hi) - math.log(lo)) / (math.log(high) - math.log(low))
 
 
 @nb.njit(**_JIT)
@@ -258,6 +266,8 @@ def _stationarity(F, mass, c, energy, p, pressure, yield_pressure):
 @nb.njit(**_JIT)
 def _root_on(a, b, mass, c, energy, p, pressure, yield_pressure):
     """The root of the (decreasing) stationarity on [a, b], or -1 when it does not change sign."""
+    if a > 0.0 and p[CR_] > 0.0:  # inside the piece: at a = F_b a crushed board's pressure slope is the jump's
+        a *= 1.0 + 4e-6
     fa = _stationarity(a, mass, c, energy, p, pressure, yield_pressure) if a > 0.0 else mass * 1.0
     fb = _stationarity(b, mass, c, energy, p, pressure, yield_pressure)
     if not (fa > 0.0 and fb < 0.0):
