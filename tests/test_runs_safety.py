@@ -567,3 +567,37 @@ def test_ctrl_c_drops_a_large_chunk_being_written_instead_of_waiting(tmp_path, c
     status, out, err = cli.run("batch", source, "-o", tmp_path / "out.parquet", "--chunk-size", 25)
     assert status == 130 and err.strip().endswith("interrupted; no chunk was complete: nothing kept"), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.csv"]  # no part, no temporary, no output
+
+
+def test_ctrl_c_before_any_chunk_into_a_users_work_folder_says_nothing_was_kept(tmp_path, cli, monkeypatch):
+    """With --workdir an existing (empty) folder of the user's, an interrupt before any chunk said "completed chunks
+    are kept" because the folder was still there (it is the user's, so it stays): the message now follows the
+    manifest (found by a review)."""
+    source = velocities_csv(tmp_path / "in.csv")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    monkeypatch.setattr(runs.chunks, "compute_chunk", Interrupt(0))
+    status, _, err = cli.run("batch", source, "-o", tmp_path / "out.csv", "--workdir", mine)
+    assert status == 130 and err.strip().endswith("interrupted; no chunk was complete: nothing kept"), err
+    assert mine.is_dir() and not list(mine.iterdir())
+
+
+def test_sample_files_as_spreadsheets_and_pandas_write_them(tmp_path, cli, monkeypatch):
+    """What the pandas-based reader read must still read (a review of the csv/pyarrow readers): a repeated header
+    that is not the sampled column, an export's trailing unnamed columns, pandas' index column in a Parquet
+    file, a categorical and a decimal column; and what float() alone would take but the unit parser refuses
+    ("1_0") stays refused.  Each member is one of the file's values (checked in the written rows)."""
+    import decimal
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "notes.csv").write_text("note,note,mass\na,b,0.1\nc,d,0.12\n")
+    (tmp_path / "excel.csv").write_text("mass,,\n0.1,,\n0.12,,\n")
+    pd.DataFrame({"weight": [0.1, 0.12]}, index=[5, 7]).to_parquet(tmp_path / "idx.parquet")
+    pd.DataFrame({"mass": pd.Categorical(["100g", "0.12"])}).to_parquet(tmp_path / "cat.parquet")
+    pq.write_table(pa.table({"mass": pa.array([decimal.Decimal("0.100"), decimal.Decimal("0.120")],
+                                              pa.decimal128(5, 3))}), tmp_path / "dec.parquet")
+    for spec in ("notes.csv:mass", "excel.csv", "idx.parquet", "cat.parquet:mass", "dec.parquet:mass"):
+        cli.ok("population", "-n", "100", "--mass", f"sample({spec})", "--no-spreads", "-o", "p.parquet")
+        assert sorted(set(np.round(pd.read_parquet("p.parquet")["mass"], 12))) == [0.1, 0.12], spec
+    (tmp_path / "us.csv").write_text("mass\n1_0\n")
+    assert "unknown unit '_0' in '1_0'" in cli.error("population", "-n", "10", "--mass", "sample(us.csv)")

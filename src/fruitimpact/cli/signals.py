@@ -351,13 +351,9 @@ def cmd_synth(args) -> int:
     path = _library_call(write_recording, recording, args.output, fmt)
     # the truth names its recording by checksum: a run stopped between the two files (each written atomically)
     # leaves a new recording beside an earlier truth, which the checksum then shows not to be its own
-    import hashlib
+    from fruitimpact.runs.sources import file_digest
 
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    truth["recording"] = {"file": Path(path).name, "sha256": digest.hexdigest()}
+    truth["recording"] = {"file": Path(path).name, "sha256": file_digest(path)}
     truth_file = _library_call(write_truth, truth, truth_path(args.output))
     print(f"{len(truth['impacts'])} impacts ({sum(1 for i in truth['impacts'] if i['rebound'])} rebounds) in "
           f"{recording.duration:.4g} s at {recording.rate:g} Hz, {len(recording.lanes)} lane(s): written to {path}, "

@@ -236,18 +236,20 @@ _MISSING = frozenset(token.lower() for token in ("", "#N/A", "#N/A N/A", "#NA", 
 
 
 def _choose_column(path: str, header, column: str | None, default_column: str | None) -> str:
-    twice = sorted({str(name) for name in header if list(header).count(name) > 1})
-    if twice:  # which of the two would be the sample is a guess
-        raise ValueError(f"sample: {path!r}: column {twice[0]!r} is given twice")
+    header = list(header)
+    named = [name for name in header if str(name).strip()]  # an unnamed (empty) column is no candidate
     if column is None:
         if default_column is not None and default_column in header:
-            return default_column
-        if len(header) == 1:
-            return header[0]
-        raise ValueError(f"sample: {path!r} has columns {', '.join(map(str, header))}; name one as "
-                         f"sample(FILE:COLUMN)")
+            column = default_column
+        elif len(named) == 1:
+            column = named[0]
+        else:
+            raise ValueError(f"sample: {path!r} has columns {', '.join(map(str, named))}; name one as "
+                             f"sample(FILE:COLUMN)")
     if column not in header:
         raise ValueError(f"sample: {path!r} has no column {column!r}")
+    if header.count(column) > 1:  # which of the two would be the sample is a guess
+        raise ValueError(f"sample: {path!r}: column {column!r} is given twice")
     return column
 
 
@@ -285,7 +287,6 @@ def _parquet_cells(path: str, column: str | None, default_column: str | None) ->
     numbers (integer or floating) as floats, text as its cells (units allowed); nulls are no value.  Any other
     type (true/false, a date, a structure, a list, bytes) is refused: it is no measurement of a quantity."""
     import pyarrow as pa
-    import pyarrow.compute as pc
     import pyarrow.parquet as pq
 
     try:
@@ -293,32 +294,38 @@ def _parquet_cells(path: str, column: str | None, default_column: str | None) ->
     except (OSError, ValueError, pa.ArrowException) as exc:  # not Parquet: one line
         lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
         raise ValueError(f"sample: cannot read {path!r}: {lines[0] if lines else type(exc).__name__}") from None
-    column = _choose_column(path, schema.names, column, default_column)
+    # pandas writes its index as a column of its own: not a measurement
+    names = [name for name in schema.names if not str(name).startswith("__index_level_")]
+    column = _choose_column(path, names, column, default_column)
     kind = schema.field(column).type
-    numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind)
+    if pa.types.is_dictionary(kind):  # a pandas categorical: its values are what it holds
+        kind = kind.value_type
+    numeric = pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind)
     if not (numeric or pa.types.is_string(kind) or pa.types.is_large_string(kind)):
         raise ValueError(f"sample: column {column!r} of {path!r} holds {kind}: give numbers [SI] or text with "
                          f"units")
     try:
         data = pq.read_table(path, columns=[column]).column(0).drop_null()
+        if pa.types.is_dictionary(data.type):
+            data = data.cast(kind)
     except (OSError, ValueError, pa.ArrowException) as exc:
         raise ValueError(f"sample: cannot read {path!r}: {str(exc).splitlines()[0]}") from None
     if not numeric:
         return column, [str(cell).strip() for cell in data.to_pylist()], False
-    # each chunk's buffer as it is: Arrow's to_numpy imports pandas (0.3 s, in a refusal too)
-    data = pc.cast(data, pa.float64())
-    values = np.concatenate([np.frombuffer(chunk.buffers()[1], dtype=np.float64, count=len(chunk),
-                                           offset=chunk.offset * 8) for chunk in data.chunks]) \
-        if data.num_chunks else np.empty(0)
-    return column, values, True
+    from fruitimpact.impact.inputs import arrow_floats
+
+    return column, arrow_floats(data), True
 
 
 def _numbers(cells, dimension: str) -> np.ndarray:
-    """Cells (text) → values [SI]: plain numbers at once, else each through the unit parser."""
-    try:
-        return np.array(cells, dtype=float)
-    except ValueError:  # a unit or a word in a cell
-        return np.array([parse_quantity(c, dimension) for c in cells], dtype=float)
+    """Cells (text) → values [SI]: plain numbers at once, else each through the unit parser (which also refuses
+    what Python's float() alone would take, such as "1_0")."""
+    if not any("_" in cell for cell in cells):
+        try:
+            return np.array(cells, dtype=float)
+        except ValueError:  # a unit or a word in a cell
+            pass
+    return np.array([parse_quantity(c, dimension) for c in cells], dtype=float)
 
 
 def _read_sample(argument: str, dimension: str, default_column: str | None) -> Sample:

@@ -2,9 +2,10 @@
 
 The in-process engine stores chunk i in a writer thread while chunk i+1 is computed.  A Ctrl-C then waits for
 that chunk to be stored, which with large chunks took seconds (7.8 s for 3,000,000 rows: an attack).  Instead the
-interrupted run marks its writer thread, and the writer stops at its next slice of ``WRITE_SLICE`` rows: the part
-file's temporary is removed unrenamed (so the chunk is not kept, and computed again on resume), and the output's
-temporary is discarded with the interrupted run.  Marked by thread, so that other runs of the process go on.
+interrupted run sets its own stop event, which its writer thread holds (``attach``), and the writer stops at its
+next slice of ``WRITE_SLICE`` rows: the part file's temporary is removed unrenamed (so the chunk is not kept, and
+computed again on resume), and the output's temporary is discarded with the interrupted run.  An event per run,
+held by that run's writer thread: another run of the process is never stopped by it.
 """
 
 from __future__ import annotations
@@ -15,24 +16,18 @@ import threading
 #: in about half a second (CSV text; a Parquet row group of this size is as good as a larger one).
 WRITE_SLICE = 1 << 19
 
-_MARKED: set[int] = set()
-_LOCK = threading.Lock()
+_HELD = threading.local()
 
 
-def mark(threads) -> None:
-    """Ask the threads ``threads`` (idents) to abandon what they write."""
-    with _LOCK:
-        _MARKED.update(threads)
-
-
-def unmark(threads) -> None:
-    with _LOCK:
-        _MARKED.difference_update(threads)
+def attach(stop: threading.Event) -> None:
+    """This thread writes for the run whose stop event is ``stop``."""
+    _HELD.stop = stop
 
 
 def check() -> None:
-    """KeyboardInterrupt in a marked thread: its run was interrupted."""
-    if threading.get_ident() in _MARKED:
+    """KeyboardInterrupt in a writer thread whose run was interrupted."""
+    stop = getattr(_HELD, "stop", None)
+    if stop is not None and stop.is_set():
         raise KeyboardInterrupt
 
 
@@ -48,4 +43,4 @@ def slices(table):
         yield table.slice(start, WRITE_SLICE)
 
 
-__all__ = ["WRITE_SLICE", "check", "mark", "slices", "unmark"]
+__all__ = ["WRITE_SLICE", "attach", "check", "slices"]

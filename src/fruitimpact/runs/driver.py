@@ -206,8 +206,11 @@ def execute(plan, output=None, *, engine=None, workdir=None, fresh: bool = False
         work = WorkDir.open(workdir, plan.fingerprint(), plan.identity(), fresh=fresh, spare=output)
         try:
             summary = _run(plan, work, output, engine, percentiles, keep_columns)
-        except BaseException:
-            if not _kept(work):
+        except BaseException as exc:
+            # an interrupt is known to have stopped every writer only in this process (a cluster's running tasks
+            # go on writing into the folder): only then may the folder go
+            settled = isinstance(exc, Exception) or isinstance(engine, InProcessEngine)
+            if settled and not _kept(work):
                 # failed or interrupted before any chunk was kept (a Dask scheduler that does not answer, a Ctrl-C
                 # in the first chunk): nothing to resume, so the folder's own files go, and the folder if this run
                 # made it (kept, it refused the next, different job to that output as "another job's parts")

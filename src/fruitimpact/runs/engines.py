@@ -25,7 +25,7 @@ def check_scheduler(address: str) -> str:
 
 
 #: What the writer thread uses, imported by the driving thread before the writer starts (``preload_writer_modules``).
-WRITER_MODULES = ("pandas", "pyarrow", "pyarrow.csv", "pyarrow.ipc", "pyarrow.parquet")
+WRITER_MODULES = ("pyarrow", "pyarrow.csv", "pyarrow.ipc", "pyarrow.parquet")
 
 
 def preload_writer_modules() -> None:
@@ -33,7 +33,8 @@ def preload_writer_modules() -> None:
     a Ctrl-C: a KeyboardInterrupt that lands inside an import of the driving thread (Arrow imports pandas on its
     first conversion to NumPy) leaves CPython's import lock held, and the interrupted run then waits for the
     writer, which waits for that lock (found by an attack: 8 of 28 Ctrl-Cs half a second into a batch hung for
-    good).  With nothing left to import, the writer never needs the lock."""
+    good).  With nothing left to import, the writer never needs the lock (pandas is the driving thread's own
+    import, not the writer's: preloading it cost every run 0.18 s)."""
     import importlib
 
     for name in WRITER_MODULES:
@@ -65,10 +66,10 @@ class InProcessEngine:
 
         preload_writer_modules()
 
-        writers = set()
+        stop = threading.Event()
 
         def store(computed):
-            writers.add(threading.get_ident())
+            abandon.attach(stop)
             done(store_chunk(plan, computed, workdir, keep_rows=True))
 
         with ThreadPoolExecutor(1, thread_name_prefix="fruitimpact-writer") as writer:
@@ -82,11 +83,8 @@ class InProcessEngine:
                 if writing is not None:
                     writing.result()
             except KeyboardInterrupt:
-                abandon.mark(writers)  # the chunk being written is dropped at its next slice, not waited for
+                stop.set()  # the chunk being written is dropped at its next slice, not waited for
                 raise
-            finally:
-                writer.shutdown(wait=True)
-                abandon.unmark(writers)
 
 
 @dataclass(frozen=True)
