@@ -115,7 +115,7 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
 
     Every input is checked before anything is drawn: an unknown name, an input of ``excluded`` (``excluded_reason``
     says why), a text input not in its registry, a distribution that cannot be read, two alternatives given
-    together, a constant out of its range or one the others need (``impact.evaluation.refuse_constants``).  The
+    together, a constant out of its range or one the others need (``impact.refusals.refuse_constants``).  The
     inputs not given are drawn from the fruit's library spreads unless ``spreads`` is False (the bruise inputs
     only with a ``criterion``), except those of ``fixed`` (each evaluation of the lot sets them: a risk map's
     axis).  ``InputError`` naming the input otherwise."""
@@ -147,7 +147,7 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     given = [name for name, _ in distributions] + list(text)
     check_conflicts(given)
     refuse_out_of_range(constants)  # at once: the one-row evaluation below loads the engine (numba)
-    from fruitimpact.impact.evaluation import refuse_constants
+    from fruitimpact.impact.refusals import refuse_constants
 
     refuse_constants(constants, {**text, **({"criterion": criterion} if criterion else {})}, given)
     extra, density, described, bases = lot_distributions(text.get("fruit"),
@@ -161,7 +161,7 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
         # distribution) that every member fails, such as a step too coarse for rk4 or a mass drawn below zero, is
         # a usage error; a larger lot is left to its rows (one runnable fruit among them must run), and a run with
         # no row ok says so in its exit status.  Not where each point or axis sets inputs later.
-        from fruitimpact.impact.evaluation import refuse_lot
+        from fruitimpact.impact.refusals import refuse_lot
 
         refuse_lot(source.inputs(0, rows, None)[0], given, f"the lot's {rows:,} fruit")
     return source, text, tuple(described)

@@ -208,7 +208,7 @@ DEPENDENT_INPUTS = ("alpha", "step")
 def refuse_out_of_range(constants: dict) -> None:
     """Refuse the first constant input (name → a number [SI]; in the table's order of inputs) outside its allowed
     range, with the message a row of the table gets (``range_message``), before anything loads the engine: the
-    check a run's one-row evaluation (``evaluation.refuse_constants``) would make first, answered at once (a usage
+    check a run's one-row evaluation (``refusals.refuse_constants``) would make first, answered at once (a usage
     error in ≤ 0.25 s, issue 15 item 4).  ``DEPENDENT_INPUTS`` are checked against their own range here (a step
     of 0 is no step for any fruit); the bound that depends on other inputs, NaN and what is not a number are left
     to that evaluation."""

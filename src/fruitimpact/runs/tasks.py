@@ -210,7 +210,7 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
             text[name] = axis.values[0]
     check_conflicts(list(axes_text))
     refuse_out_of_range(constants)  # at once: the one-row evaluation below loads the engine (numba)
-    from fruitimpact.impact.evaluation import refuse_constants
+    from fruitimpact.impact.refusals import refuse_constants
 
     refuse_constants(constants, text, list(axes_text))
     points = math.prod(len(a.values) for a in axes)
@@ -220,7 +220,7 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
     fixed = [Axis(k, (v,)) for k, v in {**constants, **text}.items()]
     grid = GridSource(tuple(axes + fixed))
     if points <= PILOT_ROWS:  # a bound that depends on the swept inputs (rk4's step), judged on the whole grid
-        from fruitimpact.impact.evaluation import refuse_lot
+        from fruitimpact.impact.refusals import refuse_lot
 
         refuse_lot(grid.inputs(0, points, None)[0], list(axes_text), f"the grid's {points:,} points")
     return Plan("sweep", grid, chunk_size, write_rows=write_rows), tuple(axes)
