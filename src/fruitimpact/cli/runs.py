@@ -64,16 +64,11 @@ def _run(args, plan, keep_columns=(), percentiles=None):
     except runs.RunError as exc:
         raise UsageError(str(exc)) from None
     except KeyboardInterrupt:
-        from pathlib import Path
-
-        from fruitimpact.runs.workdir import MANIFEST
+        from fruitimpact.runs.workdir import recorded_chunks
 
         # what the manifest records, not whether the folder is there (a --workdir of the user's stays, empty)
-        manifest = Path(checked[1]) / MANIFEST if checked[1] is not None else None
-        chunks = len(manifest.read_text(errors="replace").splitlines()) - 1 \
-            if manifest is not None and manifest.is_file() else 0
-        kept = (f"completed chunks are kept in {checked[1]}: run the same command again to resume" if chunks > 0
-                else "no chunk was complete: nothing kept")
+        kept = (f"completed chunks are kept in {checked[1]}: run the same command again to resume"
+                if checked[1] is not None and recorded_chunks(checked[1]) else "no chunk was complete: nothing kept")
         print(f"{PROG} {args.command}: interrupted; {kept}", file=sys.stderr)
         return None
 

@@ -29,7 +29,7 @@ _LEGACY_STREAMS = ("mass", "diameter", "modulus", "poisson", "stiffness", "veloc
 #: Random stream of the percentile-sample keys.
 KEY_STREAM = 1000
 #: The largest lot or grid validated whole before a run (``read_lot``, ``runs.tasks.sweep_plan``): a few ms.
-PILOT_ROWS = 4096
+PRECHECK_ROWS = 4096
 
 
 def stream_number(name: str) -> int:
@@ -156,7 +156,7 @@ def read_lot(inputs, *, rows: int, seed: int, spreads: bool = True, criterion: s
     if bases:
         extra, described = _one_bruise_basis(extra, described, dict(bases), distributions, text)
     source = PopulationSource(tuple(distributions) + tuple(extra), tuple(text.items()), rows, seed, density)
-    if not excluded and not fixed and rows <= PILOT_ROWS:
+    if not excluded and not fixed and rows <= PRECHECK_ROWS:
         # a lot small enough to validate whole before the run (a few ms): an input of the user's (a constant or a
         # distribution) that every member fails, such as a step too coarse for rk4 or a mass drawn below zero, is
         # a usage error; a larger lot is left to its rows (one runnable fruit among them must run), and a run with

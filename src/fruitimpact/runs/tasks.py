@@ -18,7 +18,7 @@ from pathlib import Path
 
 from fruitimpact.impact.validation import (InputError, check_choice, check_conflicts, check_flag, check_input_name, is_boolean,
                                            read_count, refuse_out_of_range, spec_text)
-from fruitimpact.impact.lots import PILOT_ROWS
+from fruitimpact.impact.lots import PRECHECK_ROWS
 from fruitimpact.runs.plan import (CHUNK_ROWS, MAX_CHUNK_ROWS, MAX_ROWS, MAX_SAMPLE_ROWS, PERCENTILES, SAMPLE_ROWS,
                                    Plan, Threshold, characteristic, characteristics_list,
                                    check_criterion_for)
@@ -219,7 +219,7 @@ def sweep_plan(axes_text: Mapping, chunk_size=CHUNK_ROWS, write_rows: bool = Tru
                          f"a sweep has at most {MAX_ROWS:,}")
     fixed = [Axis(k, (v,)) for k, v in {**constants, **text}.items()]
     grid = GridSource(tuple(axes + fixed))
-    if points <= PILOT_ROWS:  # a bound that depends on the swept inputs (rk4's step), judged on the whole grid
+    if points <= PRECHECK_ROWS:  # a bound that depends on the swept inputs (rk4's step), judged on the whole grid
         from fruitimpact.impact.refusals import refuse_lot
 
         refuse_lot(grid.inputs(0, points, None)[0], list(axes_text), f"the grid's {points:,} points")

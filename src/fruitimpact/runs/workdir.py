@@ -93,6 +93,26 @@ def _write_file(path: Path, write) -> dict:
     return {"name": path.name, "bytes": sink.size, "sha256": sink.digest.hexdigest()}
 
 
+def manifest_lines(folder) -> list[dict]:
+    """The readable lines of the manifest in ``folder`` (a torn or garbled line is skipped; none without one)."""
+    try:
+        text = (Path(folder) / MANIFEST).read_text(errors="replace")
+    except OSError:
+        return []
+    lines = []
+    for line in text.splitlines():
+        try:
+            lines.append(json.loads(line))
+        except ValueError:
+            continue
+    return lines
+
+
+def recorded_chunks(folder) -> dict[int, dict]:
+    """The completed chunks the manifest in ``folder`` records, by index (the last record of a chunk wins)."""
+    return {line["chunk"]: line for line in manifest_lines(folder)[1:] if isinstance(line.get("chunk"), int)}
+
+
 def write_part(workdir, index: int, table) -> dict:
     """Write chunk ``index``'s rows (a pyarrow Table) as its part file; returns its file entry."""
     import pyarrow as pa
@@ -248,18 +268,7 @@ class WorkDir:
         os.replace(tmp, self.path / MANIFEST)
 
     def _lines(self) -> list[dict]:
-        """The manifest's readable lines (a torn or garbled line is skipped)."""
-        try:
-            text = (self.path / MANIFEST).read_text(errors="replace")
-        except OSError:
-            return []
-        lines = []
-        for line in text.splitlines():
-            try:
-                lines.append(json.loads(line))
-            except ValueError:
-                continue
-        return lines
+        return manifest_lines(self.path)
 
     def _header(self) -> dict | None:
         lines = self._lines()
@@ -267,7 +276,7 @@ class WorkDir:
 
     def records(self) -> dict[int, dict]:
         """The completed chunks the manifest records, by index (the last record of a chunk wins)."""
-        return {line["chunk"]: line for line in self._lines()[1:] if isinstance(line.get("chunk"), int)}
+        return recorded_chunks(self.path)
 
     def verified(self, record: dict) -> bool:
         """Whether every file of ``record`` is there with its recorded size and SHA-256."""
