@@ -40,10 +40,11 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
-                                         from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
-                                         likeliest_hidden, rebounds_due, rebounds_landed_together, refine,
-                                         shape_table, too_light_for_fruit, unmeasured_fruit)
+from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent,
+                                         expected_rebound, from_indices, hidden_rebound, judge, judge_unmeasured,
+                                         landed_with_rebound, likeliest_hidden, rebound_of_a_rebound, rebounds_due,
+                                         rebounds_landed_together, refine, shape_table, too_light_for_fruit,
+                                         unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -105,6 +106,8 @@ class LineAnalyzer:
         self._fruit: dict[int, list[PulseSummary]] = {}
         #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
+        #: per lane: [new fruit, rebounds] reported so far (``_quiet_fruit``)
+        self._tally: dict[int, list[int]] = {}
         #: per lane: the impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
         self._speeds: dict[int, list[float]] = {}
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
@@ -241,7 +244,8 @@ class LineAnalyzer:
             summary = from_indices(impact_indices(piece, self.analysis.rate), -1, noise, None)
             rebound = summary is not None and judge(refine(summary, fit), history,
                                                     max_flight=self.analysis.flight_limit,
-                                                    last_fruit_onset=last_fruit, pitch=self.analysis.pitch).rebound
+                                                    last_fruit_onset=last_fruit, pitch=self.analysis.pitch,
+                                                    quiet_fruit=self._quiet_fruit(lane)).rebound
             if summary is not None and not rebound:
                 last_fruit = summary.onset
             flags.append(rebound)
@@ -304,7 +308,8 @@ class LineAnalyzer:
         verdict = None
         if summary is not None and analysis.flight_limit > 0:
             verdict = judge(summary, history, max_flight=analysis.flight_limit,
-                            last_fruit_onset=self._last_fruit.get(impact.lane), pitch=analysis.pitch)
+                            last_fruit_onset=self._last_fruit.get(impact.lane), pitch=analysis.pitch,
+                            quiet_fruit=self._quiet_fruit(impact.lane))
         chosen, hidden_fruit = verdict, False
         judged = verdict is not None and (verdict.rebound or verdict.ambiguous)
         if summary is not None and (not judged or verdict.ambiguous):
@@ -327,6 +332,16 @@ class LineAnalyzer:
         orphan = None
         if not rebound and status == "ok" and summary is not None and together is None and pair is None:
             orphan = too_light_for_fruit(summary, self._lane_fruit(impact.lane))
+        slow_parent = False
+        if not rebound and status == "ok" and summary is not None and together is None and pair is None \
+                and orphan is None:
+            # perhaps the bounce of a rebound that was itself taken for a fruit (its parent hidden in an overlap)
+            own = {fruit.sequence for fruit in self._fruit.get(impact.lane, [])}
+            slow = rebound_of_a_rebound(summary, [p for p in reversed(history) if p.sequence in own],
+                                        self._lane_fruit(impact.lane), self.line_speed(impact.lane),
+                                        analysis.flight_limit)
+            if slow.rebound:
+                chosen, rebound, hidden_fruit, slow_parent = slow, True, False, True
         if orphan is not None:  # a rebound whose parent's pulse was not measured as it was: not graded
             if chosen is not None and chosen.evidence:  # a near miss of a known parent, kept as evidence
                 orphan["nearest_parent"] = chosen.evidence
@@ -343,11 +358,19 @@ class LineAnalyzer:
             _without_firmness(report)
         speed = self.line_speed(impact.lane)
         read = analysis.velocity is None  # a speed read from the lane's rebounds: no flight is tested against it
+        landing = math.nan  # the impact speed its own flight shows, for its next bounce (a hidden fruit's rebound)
         if orphan is not None:
             speed = None  # its speed is not measured: the fit leaves m and K unsplit
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
+            landing = ballistic_speed(chosen.evidence["flight_observed"])
+        elif rebound and slow_parent:  # its parent was a rebound taken for a fruit: no longer one of the lane's fruit
+            index = claimed_parent(summary, history, chosen.parent)
+            history[index] = history[index].taken()
+            self._fruit[impact.lane] = [f for f in self._fruit[impact.lane] if f.sequence != chosen.parent]
+            speed = None  # the parent's speed is read from this flight, not measured: the fit leaves m and K unsplit
+            landing = chosen.evidence["landing_speed"]
         elif rebound and chosen is not None:
             index = claimed_parent(summary, history, chosen.parent)
             parent = history[index]
@@ -372,12 +395,16 @@ class LineAnalyzer:
             if speed is None and result.get("converged") and _finite(result.get("velocity")):
                 speed, read = result["velocity"], False  # the mass was given: the fit found the speed
         if summary is not None:
-            history.append(summary.with_velocity(speed, read))
+            # a hidden fruit's rebound: its flight from the overlap fixes the speed it landed at, so its own bounce
+            # can be expected (``rebounds_due``) and its flight tested; the fit still leaves its m and K unsplit
+            history.append(summary.with_velocity(landing, False) if speed is None and _finite(landing)
+                           else summary.with_velocity(speed, read))
             # keep the contacts a later one could still be the rebound of
             recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
             history[:] = recent[-8:]
         if not rebound and status != "overlap":
             self._last_fruit[impact.lane] = report["start_time"]
+        self._tally.setdefault(impact.lane, [0, 0])[1 if rebound else 0] += status != "overlap" or rebound
         if pair is not None:  # both rebounds are seen, and each may bounce again from here
             for parent in pair_parents:
                 index = next((i for i, s in enumerate(history) if s is parent), None)
@@ -413,6 +440,12 @@ class LineAnalyzer:
         report["status"] = status
         report["message"] = message
         return report
+
+    def _quiet_fruit(self, lane: int) -> int:
+        """How many fruit ``lane`` has reported without a single rebound (0 once it has shown one): a lane that
+        stops its fruit (``rebounds.QUIET_LANE_FRUIT``)."""
+        fruit, rebounds = self._tally.get(lane, (0, 0))
+        return 0 if rebounds else fruit
 
     def reads_speed(self) -> bool:
         """Whether the impact speed is read from the rebounds: neither given nor found by each fit (the mass
@@ -486,6 +519,13 @@ class LineAnalyzer:
 #: the same for every rate, and its cost grows with the rate (13 s at 10 MHz), so it runs once, at this rate.
 WARM_RATE = 20_000.0
 _WARM: list = []
+
+
+def ballistic_speed(flight: float) -> float:
+    """The speed [m/s] at which a fruit that left the plate lands on it again after ``flight`` [s] in the air:
+    u = g · flight / 2 (a ballistic flight between two points at one height, drag neglected; spin and an off-axis
+    bounce change the path, not the vertical motion that the flight time measures).  NaN for a flight ≤ 0."""
+    return STANDARD_GRAVITY * flight / 2.0 if _finite(flight) and flight > 0 else math.nan
 
 
 def _warm_up(analysis: Analysis) -> None:

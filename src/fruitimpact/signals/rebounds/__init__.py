@@ -54,18 +54,19 @@ lane's measured fruit, standing for a fruit that was not measured).
 
 from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, LANE_FRUIT_MIN,
                                                LOT_IMPULSE_SD, LOT_STIFFNESS_SD, ORPHAN_MARGIN, PAIR_DISTANCE_MAX,
-                                               PAIR_MARGIN, LaneFruit, judge_unmeasured, landed_with_rebound,
-                                               lane_fruit, rebounds_landed_together, too_light_for_fruit,
-                                               unmeasured_fruit)
+                                               PAIR_MARGIN, SLOW_PARENT_RATIO, LaneFruit, judge_unmeasured,
+                                               landed_with_rebound, lane_fruit, rebound_of_a_rebound,
+                                               rebounds_landed_together, too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
-                                                   claimed_parent, expected_rebound, hidden_rebound, judge,
-                                                   likeliest_hidden, rebounds_due)
+                                                   QUIET_LANE_FRUIT, claimed_parent, expected_rebound,
+                                                   hidden_rebound, judge, likeliest_hidden, rebounds_due)
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
                                                  from_indices, refine, shape_table)
 
 __all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
            "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
-           "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "RAW_SD", "TOLERANCES", "Verdict",
-           "claimed_parent", "expected_rebound", "from_indices", "hidden_rebound", "judge", "judge_unmeasured",
-           "landed_with_rebound", "lane_fruit", "likeliest_hidden", "rebounds_due", "rebounds_landed_together",
-           "refine", "shape_table", "too_light_for_fruit", "unmeasured_fruit"]
+           "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
+           "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",
+           "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit", "likeliest_hidden",
+           "rebound_of_a_rebound", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
+           "too_light_for_fruit", "unmeasured_fruit"]

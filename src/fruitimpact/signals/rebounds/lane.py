@@ -12,7 +12,7 @@ import numpy as np
 
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
-                                                     _rebound_pulse)
+                                                     _hypothesis, _rebound_pulse)
 from fruitimpact.signals.rebounds.pulses import AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at
 
 
@@ -242,6 +242,12 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
 PAIR_DISTANCE_MAX, PAIR_MARGIN = 1.25, 1.5
 
 
+#: The spread (sd) of the restitution of a lot's fruit, assumed while a lane has measured fewer than
+#: ``LANE_FRUIT_MIN`` (``rebounds_landed_together``): the damping factor c varies by 20–30 % between fruit of one
+#: lot, which moves e by ±0.05–0.07 at e ≈ 0.6 (split.RESTITUTION_SPREAD takes ±0.12 as the lot's range).
+FEW_FRUIT_RESTITUTION_SD = 0.06
+
+
 def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
                              fruit: list[PulseSummary]) -> tuple[dict, list[PulseSummary]] | None:
     """Is ``candidate``, one pulse judged no rebound, the rebounds of two earlier contacts that landed together?
@@ -252,15 +258,18 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
     ``EXPECTED_RATIO`` e_p ± ``EXPECTED_RATIO_SD``) added, and a rebound's restitution (a slower impact: livelier
     than the lane's fruit).  Of the pairs of ``due`` contacts (``rebounds_due``), the nearest in impulse and
     restitution (in sd) is taken when it lies within ``PAIR_DISTANCE_MAX`` and a new fruit of the lane (the
-    medians and robust spreads of its measured ``fruit``, at least ``LANE_FRUIT_MIN``; spreads at least
-    ``LOT_IMPULSE_SD`` and ``LOT_RESTITUTION_SD``) lies ``PAIR_MARGIN`` times farther.  Returns (the evidence:
+    medians and robust spreads of its measured ``fruit``, at least one; spreads at least ``LOT_IMPULSE_SD`` and
+    ``LOT_RESTITUTION_SD``, or ``FEW_FRUIT_RESTITUTION_SD`` before the lane has ``LANE_FRUIT_MIN``) lies
+    ``PAIR_MARGIN`` times farther.  Returns (the evidence:
     ``kind`` "two rebounds", ``parents`` (their sequences), both distances; the two parents themselves) or None."""
-    if len(fruit) < LANE_FRUIT_MIN or not candidate.refined or len(due) < 2:
+    if not fruit or not candidate.refined or len(due) < 2:
         return None
     lane = lane_fruit(fruit)
     impulse_lane, e_lane = lane.impulse, lane.restitution
     impulse_sd = math.hypot(max(lane.impulse_sd, LOT_IMPULSE_SD), candidate.impulse_sd)
-    e_lane_sd = math.hypot(max(lane.restitution_sd, LOT_RESTITUTION_SD), candidate.restitution_sd)
+    # fewer than ``LANE_FRUIT_MIN`` fruit (a recording's first contacts) measure no spread of e: a lot's stands in
+    e_floor = LOT_RESTITUTION_SD if len(fruit) >= LANE_FRUIT_MIN else FEW_FRUIT_RESTITUTION_SD
+    e_lane_sd = math.hypot(max(lane.restitution_sd, e_floor), candidate.restitution_sd)
     new_fruit = math.hypot(math.log(candidate.impulse / impulse_lane) / impulse_sd,
                            (candidate.restitution - e_lane) / e_lane_sd)
     pulses = [(parent, _rebound_pulse(parent)) for parent in due]
@@ -412,3 +421,78 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     if not rebound and not ambiguous:
         return NEW_FRUIT
     return Verdict(rebound, hidden if rebound else None, ambiguous, r if rebound else None, evidence)
+
+
+#: The speed of a contact that was itself a rebound, as a share of the line's speed, read from its own rebound's
+#: flight (``rebound_of_a_rebound``): a first bounce lands at r V with r = e less spin (0.35–0.8 for fruit of
+#: e 0.45–0.85), a second at r² V (0.15–0.6).  A flight that says the parent moved at 0.85 V or more is a fruit's
+#: own rebound landing late, which the flight tolerance already covers.
+SLOW_PARENT_RATIO = (0.12, 0.85)
+
+
+def rebound_of_a_rebound(candidate: PulseSummary, parents: list[PulseSummary], fruit: list[PulseSummary],
+                         velocity: float | None, max_flight: float) -> Verdict:
+    """Is ``candidate``, a contact no test claims, the rebound of one of ``parents`` (earlier contacts of its lane
+    taken for new fruit at the line's speed ``velocity`` [m/s]) that was itself a rebound?
+
+    A rebound of a fruit hidden in an overlap can pass for a new fruit (a heavy or lively fruit's rebound
+    carries a typical fruit's impulse), and is then taken to have landed at the line's speed V.  Its own
+    bounce fails the flight test against that speed (it lands after 2 r V_p/g with V_p the speed it really
+    had, less than V) and is taken for a new fruit in turn: the mistake cascades.  The samples say more than
+    that:
+
+    * the candidate is the same fruit as the parent on every test that does not need the parent's speed
+      (``measured._hypothesis``: speed ratio r from the impulse ratio against e_p, peak force, time to peak and
+      shape x, each within its tolerance);
+    * its flight measures the speed it landed at, u = g · flight/2 (ballistic), so the parent's own speed was
+      V_p = u/r; as a share q = V_p/V of the line's speed it must be a rebound's (``SLOW_PARENT_RATIO``);
+    * as a new fruit of the lane at V it is improbable: its restitution, impulse and contact stiffness read at V
+      lie beyond the 99 % point of χ² with three degrees of freedom from the lane's measured ``fruit`` (at least
+      ``LANE_FRUIT_MIN``; ``_as_lane_rebound``).  A lighter new fruit can mimic a rebound's pulse only with a
+      stiffness r^-1.5 times lower as well, which the lot's spread of stiffness does not allow.
+
+    Then the candidate is that parent's rebound, marked ambiguous, with the evidence (the parent's speed read
+    from the flight; the parent's grade, already given, is not revised).  The nearest such parent on the tests
+    is taken.  Otherwise ``NEW_FRUIT``."""
+    if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
+        return NEW_FRUIT
+    lane = lane_fruit(fruit)
+    as_fruit = _as_lane_rebound(candidate, fruit, lane, velocity, EXPECTED_RATIO * lane.restitution)["new_fruit2"]
+    if not as_fruit >= CHI2_3_99:
+        return NEW_FRUIT  # a plausible new fruit of the lane
+    best = None
+    for parent in parents:
+        flight = candidate.onset - parent.separation
+        if parent.rebound_taken or parent.velocity is None or not 0.0 < flight <= max_flight:
+            continue
+        evidence = _hypothesis(candidate, parent)
+        shared = max(v for k, v in evidence["deviations"].items() if k != "flight" and v is not None)
+        if any(v is None for k, v in evidence["deviations"].items() if k != "flight") or shared > 1.0:
+            continue
+        r = evidence["speed_ratio"]
+        landing = STANDARD_GRAVITY * flight / 2.0
+        share = landing / r / velocity
+        if not SLOW_PARENT_RATIO[0] <= share <= SLOW_PARENT_RATIO[1]:
+            continue
+        if best is None or shared < best[0]:
+            best = (shared, parent, evidence, share, landing)
+    if best is None:
+        return NEW_FRUIT
+    shared, parent, evidence, share, landing = best
+    evidence.update(score=round(shared, 3), threshold=1.0, landing_speed=landing, parent_speed=share * velocity,
+                    parent_speed_share=round(share, 3), new_fruit_distance=round(math.sqrt(as_fruit), 3),
+                    kind="rebound_of_a_rebound",
+                    reason=(f"the same fruit as #{parent.sequence} (speed ratio, peak force, time to peak and shape "
+                            f"within {shared:.2f} of their tolerances) but landing {_flight_text(evidence)}: "
+                            f"#{parent.sequence} moved at {share:.2f} of the line's speed, so it was itself a "
+                            f"rebound (taken for a fruit, its grade given); as a new fruit this contact lies "
+                            f"{math.sqrt(as_fruit):.1f} sd from the lane's fruit"))
+    return Verdict(True, parent.sequence, True, evidence["speed_ratio"], evidence)
+
+
+def _flight_text(evidence: dict) -> str:
+    """"after 0.095 s, where a fruit at the line's speed would fly 0.139 s" (or the observed flight alone)."""
+    observed, predicted = evidence.get("flight_observed"), evidence.get("flight_predicted")
+    if predicted is None:
+        return f"after {observed:.3g} s"
+    return f"after {observed:.3g} s, where its rebound at the line's speed would fly {predicted:.3g} s"

@@ -58,25 +58,39 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
     return evidence
 
 
-def _threshold(candidate: PulseSummary, last_fruit_onset: float | None, pitch: float | None) -> tuple[float, str]:
-    """The score a rebound must stay under, from the feed prior (the package docstring)."""
-    if pitch is None or last_fruit_onset is None:
-        return 1.0, "none"
-    cycles = (candidate.onset - last_fruit_onset) / pitch
-    phase = abs(cycles - round(cycles)) if cycles >= 0.5 else math.inf
-    if phase <= 0.15:
-        return 0.8, f"on the feed's pitch ({cycles:.2f} pitches after the last fruit)"
-    if phase >= 0.3:
-        return 1.25, f"off the feed's pitch ({cycles:.2f} pitches after the last fruit)"
-    return 1.0, f"{cycles:.2f} pitches after the last fruit"
+#: A lane whose first this many fruit have shown no rebound at all lands its fruit on something that stops them (a
+#: pad, a brush, a cup): a rebound must then be clear, score ≤ 0.8 as on the feed's pitch (``judge``).  On a plate
+#: every fruit rebounds (e ≈ 0.4–0.8), so a plate lane shows its first rebound within a fruit or two.
+QUIET_LANE_FRUIT = 10
+
+
+def _threshold(candidate: PulseSummary, last_fruit_onset: float | None, pitch: float | None,
+               quiet_fruit: int = 0) -> tuple[float, str]:
+    """The score a rebound must stay under, from the feed prior and the lane's own history (the package
+    docstring; ``QUIET_LANE_FRUIT``)."""
+    threshold, prior = 1.0, "none"
+    if pitch is not None and last_fruit_onset is not None:
+        cycles = (candidate.onset - last_fruit_onset) / pitch
+        phase = abs(cycles - round(cycles)) if cycles >= 0.5 else math.inf
+        if phase <= 0.15:
+            threshold, prior = 0.8, f"on the feed's pitch ({cycles:.2f} pitches after the last fruit)"
+        elif phase >= 0.3:
+            threshold, prior = 1.25, f"off the feed's pitch ({cycles:.2f} pitches after the last fruit)"
+        else:
+            prior = f"{cycles:.2f} pitches after the last fruit"
+    if quiet_fruit >= QUIET_LANE_FRUIT:
+        quiet = f"the lane's {quiet_fruit} fruit have shown no rebound"
+        threshold, prior = 0.8 * threshold, quiet if prior == "none" else f"{prior}; {quiet}"
+    return threshold, prior
 
 
 def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: float,
-          last_fruit_onset: float | None = None, pitch: float | None = None) -> Verdict:
+          last_fruit_onset: float | None = None, pitch: float | None = None, quiet_fruit: int = 0) -> Verdict:
     """Decide whether ``candidate`` is the rebound of one of the ``earlier`` contacts of its lane (most
     recent last; those whose separation is more than ``max_flight`` [s] before its onset, and those that
-    already have their rebound, are not considered).  The best-scoring parent wins (the package docstring)."""
-    threshold, prior = _threshold(candidate, last_fruit_onset, pitch)
+    already have their rebound, are not considered).  The best-scoring parent wins (the package docstring).
+    ``quiet_fruit``: how many fruit the lane has shown without any rebound (``QUIET_LANE_FRUIT``)."""
+    threshold, prior = _threshold(candidate, last_fruit_onset, pitch, quiet_fruit)
     parents = [p for p in reversed(earlier) if not p.rebound_taken and p.onset < candidate.onset
                and candidate.onset - p.separation <= max_flight]
     best = min((_hypothesis(candidate, p) for p in parents), key=lambda ev: ev["score"], default=None)
