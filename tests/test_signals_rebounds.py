@@ -499,14 +499,21 @@ def test_the_bounce_of_a_rebound_hidden_in_an_overlap_is_a_rebound_of_the_overla
 
 
 def test_without_the_lanes_fruit_or_speed_a_hidden_fruits_rebound_is_not_guessed():
-    """Fewer than LANE_FRUIT_MIN measured fruit, or no line speed: nothing stands for the hidden fruit, so no
-    decision."""
-    from fruitimpact.signals.rebounds import LANE_FRUIT_MIN, NEW_FRUIT, judge_unmeasured
+    """No measured fruit, or no line speed: nothing stands for the hidden fruit, so no decision.  One measured
+    fruit is enough (HIDDEN_FRUIT_MIN), its spreads a lot's: the hidden fruit's rebound, landing after
+    2 · 0.95 e V/g (a little spin), is found from a recording's first fruit."""
+    from fruitimpact.signals.rebounds import HIDDEN_FRUIT_MIN, NEW_FRUIT, judge_unmeasured
 
     hidden = impact()
-    back = summary(impact(velocity=hidden["e"] * V_LINE, c=hidden["c"]), 1.1, 99)
-    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(LANE_FRUIT_MIN - 1), V_LINE) is NEW_FRUIT
+    speed = 0.95 * hidden["e"] * V_LINE
+    back = summary(impact(velocity=speed, c=hidden["c"]), 1.0 + hidden["T"] + 2 * speed / G, 99)
+    assert judge_unmeasured(back, 42, 1.0, _lane_fruit(HIDDEN_FRUIT_MIN - 1), V_LINE) is NEW_FRUIT
     assert judge_unmeasured(back, 42, 1.0, _lane_fruit(), None) is NEW_FRUIT
+    first = judge_unmeasured(back, 42, 1.0, _lane_fruit(HIDDEN_FRUIT_MIN), V_LINE)
+    assert first.rebound and first.parent == 42, first.evidence
+    new = judge_unmeasured(summary(impact(mass=0.95 * MASS, restitution=0.58), back.onset, 99), 42, 1.0,
+                           _lane_fruit(HIDDEN_FRUIT_MIN), V_LINE)
+    assert not new.rebound, new.evidence
 
 
 def test_one_fruit_alone_is_never_an_overlap():

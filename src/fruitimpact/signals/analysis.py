@@ -40,7 +40,7 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent,
+from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent,
                                          expected_rebound, from_indices, hidden_rebound, judge, judge_unmeasured,
                                          landed_with_rebound, likeliest_hidden, rebound_of_a_rebound, rebounds_due,
                                          rebounds_landed_together, refine, shape_table, too_light_for_fruit,
@@ -495,7 +495,7 @@ class LineAnalyzer:
         onset); none without the line's speed or ``LANE_FRUIT_MIN`` measured fruit."""
         velocity = self.line_speed(lane)
         fruit = self._lane_fruit(lane)
-        if velocity is None or len(fruit) < LANE_FRUIT_MIN:
+        if velocity is None or len(fruit) < HIDDEN_FRUIT_MIN:
             return []
         hidden = [unmeasured_fruit(fruit, sequence, onset, velocity)
                   for sequence, onset, _ in self._unmeasured.get(lane, []) if onset < summary.onset]

@@ -52,7 +52,7 @@ verdict), ``measured`` (a contact against earlier measured or predicted contacts
 lane's measured fruit, standing for a fruit that was not measured).
 """
 
-from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, LANE_FRUIT_MIN,
+from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN,
                                                LOT_IMPULSE_SD, LOT_STIFFNESS_SD, ORPHAN_MARGIN, PAIR_DISTANCE_MAX,
                                                PAIR_MARGIN, SLOW_PARENT_RATIO, LaneFruit, judge_unmeasured,
                                                landed_with_rebound, lane_fruit, rebound_of_a_rebound,
@@ -64,6 +64,7 @@ from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, T
                                                  from_indices, refine, shape_table)
 
 __all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
+           "HIDDEN_FRUIT_MIN",
            "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
            "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
            "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",

@@ -41,7 +41,7 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
                         time_to_peak=tc, impulse=lane.impulse, x=x, restitution=lane.restitution,
                         peak_force_sd=max(peak_sd, peak_floor), time_to_peak_sd=max(tc_sd, tc_floor),
                         impulse_sd=max(lane.impulse_sd, LOT_IMPULSE_SD), x_sd=max(x_sd, TOLERANCES["shape"]) * x,
-                        restitution_sd=max(lane.restitution_sd, LOT_RESTITUTION_SD), velocity=velocity,
+                        restitution_sd=max(lane.restitution_sd, restitution_floor(len(fruit))), velocity=velocity,
                         refined=True, virtual=True)
 
 
@@ -83,6 +83,21 @@ def _log_stiffness(summary: PulseSummary, velocity: float) -> tuple[float, float
 #: rebounds taken for fruit from 31 to 26 (the first fruit of a lane, before its fifth), fruit taken for rebounds
 #: staying 0; 2 gave the same.
 LANE_FRUIT_MIN = 3
+#: Fewest measured fruit of a lane (or of the line, ``analysis``) before the rebound of a fruit hidden in an overlap
+#: is judged (``judge_unmeasured``): a recording's first fruit are often hidden (a chain line's first rebounds land
+#: on the next fruit), and one measured fruit already says what the lot lands like, within a lot's spreads
+#: (the floors below), which stand in for the spreads the lane has not measured yet.
+HIDDEN_FRUIT_MIN = 1
+#: The spread (sd) of the restitution of a lot's fruit, assumed while a lane has measured fewer than
+#: ``LANE_FRUIT_MIN`` (``restitution_floor``): the damping factor c varies by 20–30 % between fruit of one lot,
+#: which moves e by ±0.05–0.07 at e ≈ 0.6 (split.RESTITUTION_SPREAD takes ±0.12 as the lot's range).
+FEW_FRUIT_RESTITUTION_SD = 0.06
+
+
+def restitution_floor(count: int) -> float:
+    """The least sd of the restitution of a lane's fruit, measured from ``count`` of them: ``LOT_RESTITUTION_SD``
+    once there are ``LANE_FRUIT_MIN``, a lot's own spread (``FEW_FRUIT_RESTITUTION_SD``) before."""
+    return LOT_RESTITUTION_SD if count >= LANE_FRUIT_MIN else FEW_FRUIT_RESTITUTION_SD
 
 
 def _robust_sd(values) -> float:
@@ -242,12 +257,6 @@ def too_light_for_fruit(candidate: PulseSummary, fruit: list[PulseSummary]) -> d
 PAIR_DISTANCE_MAX, PAIR_MARGIN = 1.25, 1.5
 
 
-#: The spread (sd) of the restitution of a lot's fruit, assumed while a lane has measured fewer than
-#: ``LANE_FRUIT_MIN`` (``rebounds_landed_together``): the damping factor c varies by 20–30 % between fruit of one
-#: lot, which moves e by ±0.05–0.07 at e ≈ 0.6 (split.RESTITUTION_SPREAD takes ±0.12 as the lot's range).
-FEW_FRUIT_RESTITUTION_SD = 0.06
-
-
 def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
                              fruit: list[PulseSummary]) -> tuple[dict, list[PulseSummary]] | None:
     """Is ``candidate``, one pulse judged no rebound, the rebounds of two earlier contacts that landed together?
@@ -268,8 +277,7 @@ def rebounds_landed_together(candidate: PulseSummary, due: list[PulseSummary],
     impulse_lane, e_lane = lane.impulse, lane.restitution
     impulse_sd = math.hypot(max(lane.impulse_sd, LOT_IMPULSE_SD), candidate.impulse_sd)
     # fewer than ``LANE_FRUIT_MIN`` fruit (a recording's first contacts) measure no spread of e: a lot's stands in
-    e_floor = LOT_RESTITUTION_SD if len(fruit) >= LANE_FRUIT_MIN else FEW_FRUIT_RESTITUTION_SD
-    e_lane_sd = math.hypot(max(lane.restitution_sd, e_floor), candidate.restitution_sd)
+    e_lane_sd = math.hypot(max(lane.restitution_sd, restitution_floor(len(fruit))), candidate.restitution_sd)
     new_fruit = math.hypot(math.log(candidate.impulse / impulse_lane) / impulse_sd,
                            (candidate.restitution - e_lane) / e_lane_sd)
     pulses = [(parent, _rebound_pulse(parent)) for parent in due]
@@ -335,7 +343,7 @@ def _as_lane_rebound(candidate: PulseSummary, fruit: list[PulseSummary], lane: L
         / (z * math.sqrt(impulse_sd ** 2 + r_sd ** 2 + candidate.impulse_sd ** 2)),
         "stiffness": abs(k_rebound - k_lane) / (z * math.sqrt(k_sd ** 2 + (1.5 * r_sd) ** 2 + k_meas ** 2)),
     }
-    e_lane_sd = math.hypot(max(lane.restitution_sd, LOT_RESTITUTION_SD), candidate.restitution_sd)
+    e_lane_sd = math.hypot(max(lane.restitution_sd, restitution_floor(len(fruit))), candidate.restitution_sd)
     new_fruit2 = ((candidate.restitution - e_lane) / e_lane_sd) ** 2 + \
         (math.log(candidate.impulse / impulse_lane) / math.hypot(impulse_sd, candidate.impulse_sd)) ** 2 + \
         ((k_fruit - k_lane) / math.hypot(k_sd, k_meas)) ** 2
@@ -375,7 +383,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     the impulse and the stiffness together), so that point is a scale chosen on the line recordings of
     tests/linegen.py, not a calibrated probability.  Without the line's speed or enough
     measured fruit: a new fruit, undecided (``NEW_FRUIT``)."""
-    if velocity is None or len(fruit) < LANE_FRUIT_MIN or not candidate.refined:
+    if velocity is None or len(fruit) < HIDDEN_FRUIT_MIN or not candidate.refined:
         return NEW_FRUIT
     tol = TOLERANCES
     z = tol["z"]
