@@ -4,6 +4,7 @@ One command:
 
     python benchmarks/scorecard.py [--quick] [--markdown FILE] [--scenarios NAME,NAME]
     python benchmarks/scorecard.py --seeds 1-8 [--scenarios NAME,NAME]    (other lines of the same kinds)
+    python benchmarks/scorecard.py --variants [--seeds 1,2]               (other settings of the generator)
 
 For each scenario of ``tests/linegen.py`` (chain feeding at 7 and 10 fruit/s/lane with ±8 % jitter, pads and
 plates with one or two rebounds whose flight is perturbed by ±10 %, close arrivals, hum + drift + 2–3 kHz plate
@@ -24,6 +25,8 @@ matrix and the share of fruit ≥ 5 % from a threshold that get the right class 
 ``--seeds A-B``: every scenario generated with each of those seeds instead of its own (other lines of the same
 kinds, at benchmark size), two at a time; one line per recording and the totals (recordings short of full recall,
 extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit reported as overlaps).
+``--variants``: the same at other settings of the generator (``VARIANTS``: flights ±20 %, spin to 15 %, 10 kHz,
+twice the noise, 3 and 6 cm drops), at seeds 1,2 or ``--seeds``.
 
 The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
 """
@@ -159,41 +162,59 @@ def _seeds(text: str) -> list[int]:
     return seeds
 
 
-def sweep(names: list[str], seeds: list[int]) -> int:
-    """Every scenario at every seed (``--seeds``): a line per recording and the totals."""
+#: Other settings of the same generator (``--variants``): what a line that differs from the scenarios' own does
+#: to the goals.  Each (scenario, changes): flights off by ±20 % (the issue's upper bound for spin and off-axis
+#: bounces), spin taking up to 15 % of the rebound's speed, a 10 kHz acquisition, twice the noise, drops of 3 and
+#: 6 cm (the issue's 30–60 mm).
+VARIANTS = {
+    "chain10/flight±20%": ("chain10", {"flight_jitter": 0.20}),
+    "chain10/spin≤15%": ("chain10", {"spin_loss": (0.0, 0.15)}),
+    "chain7/10kHz": ("chain7", {"rate": 10_000.0}),
+    "pad/10kHz": ("pad", {"rate": 10_000.0}),
+    "lanes4/noise×2": ("lanes4", {"noise": 0.02}),
+    "close/3cm": ("close", {"drop_height": 0.03}),
+    "chain7/6cm": ("chain7", {"drop_height": 0.06}),
+    "pears3cm/6cm": ("pears3cm", {"drop_height": 0.06}),
+}
+
+
+def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
+    """Each (label, seed, scenario) at benchmark size (``--seeds``, ``--variants``): a line per recording and the
+    totals."""
     from concurrent.futures import ThreadPoolExecutor
 
     def one(job):
-        name, seed = job
-        scenario = dataclasses.replace(lg.SCENARIOS[name], seed=seed)
+        label, seed, scenario = job
         with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
             path, truth = lg.write(scenario, Path(folder), scenario.size)
             proc = subprocess.run([console_script(), "analyze", str(path), *lg.analyze_options(truth)],
                                   capture_output=True, text=True)
         if proc.returncode != 0:
-            raise SystemExit(f"{name} seed {seed}: analyze failed ({proc.returncode}):\n{proc.stderr}")
+            raise SystemExit(f"{label} seed {seed}: analyze failed ({proc.returncode}):\n{proc.stderr}")
         reports = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
         card = lg.score(reports, truth)
         pairs = lg.match(reports, truth)["pairs"]
         card["lone_fruit_overlaps"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
                                           and r.get("status") == "overlap")
-        return name, seed, card
+        return label, seed, card
 
     keys = ("extra", "fruit_taken_for_rebounds", "rebounds_taken_for_fruit", "lone_fruit_overlaps")
     totals = dict.fromkeys(keys, 0)
     short = 0
     t0 = time.perf_counter()
-    print(f"{'scenario':<10}{'seed':>5}{'contacts':>10}{'recall':>9}{'extra':>7}{'fruit→reb':>11}{'reb→fruit':>11}"
-          f"{'lone fruit as overlap':>23}")
+    width = max(10, *(len(label) + 2 for label, _, _ in jobs))
+    print(f"{'scenario':<{width}}{'seed':>5}{'contacts':>10}{'recall':>9}{'extra':>7}{'fruit→reb':>11}"
+          f"{'reb→fruit':>11}{'lone fruit as overlap':>23}{'p95 ΔF/F':>10}{'med ΔK/K':>10}{'p95 ΔK/K':>10}")
     with ThreadPoolExecutor(2) as pool:
-        for name, seed, card in pool.map(one, [(n, s) for n in names for s in seeds]):
+        for label, seed, card in pool.map(one, jobs):
             short += card["recall"] < 1.0
             for key in keys:
                 totals[key] += card[key]
-            print(f"{name:<10}{seed:>5}{card['contacts']:>10}{card['recall']:>9.1%}{card['extra']:>7}"
+            print(f"{label:<{width}}{seed:>5}{card['contacts']:>10}{card['recall']:>9.1%}{card['extra']:>7}"
                   f"{card['fruit_taken_for_rebounds']:>11}{card['rebounds_taken_for_fruit']:>11}"
-                  f"{card['lone_fruit_overlaps']:>23}", flush=True)
-    print(f"{len(names) * len(seeds)} recordings in {time.perf_counter() - t0:.0f} s ({machine()}): "
+                  f"{card['lone_fruit_overlaps']:>23}{card['peak_force_p95']:>10.2%}{card['stiffness_median']:>10.2%}"
+                  f"{card['stiffness_p95']:>10.1%}", flush=True)
+    print(f"{len(jobs)} recordings in {time.perf_counter() - t0:.0f} s ({machine()}): "
           f"{short} short of full recall; extra {totals['extra']}, fruit taken for rebounds "
           f"{totals['fruit_taken_for_rebounds']}, rebounds taken for fruit {totals['rebounds_taken_for_fruit']}, "
           f"lone fruit as overlaps {totals['lone_fruit_overlaps']}")
@@ -209,24 +230,32 @@ def main(argv=None) -> int:
                         help="generate every scenario with this seed instead of its own (other lines of the same kind)")
     parser.add_argument("--seeds", metavar="A-B", help="every scenario at each of these seeds (e.g. 1-8 or 3,5): "
                                                          "a line per recording and the totals")
+    parser.add_argument("--variants", action="store_true",
+                        help="other settings of the generator (VARIANTS: flights ±20 %%, spin to 15 %%, 10 kHz, "
+                             "noise ×2, 3 and 6 cm drops) at seeds 1,2 (or --seeds): a line per recording")
     args = parser.parse_args(argv)
     names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
     unknown = [n for n in names if n not in lg.SCENARIOS]
     if unknown:
         parser.error(f"unknown scenarios {unknown}; known: {', '.join(lg.SCENARIOS)}")
-    if args.seeds:
+    if args.seeds or args.variants:
         others = [flag for flag, given in (("--seed", args.seed is not None), ("--quick", args.quick),
                                            ("--markdown", args.markdown)) if given]
         if others:
-            parser.error(f"--seeds runs every scenario at benchmark size and prints its own table: not with "
+            parser.error(f"--seeds and --variants run at benchmark size and print their own table: not with "
                          f"{', '.join(others)}")
         try:
-            seeds = _seeds(args.seeds)
+            seeds = _seeds(args.seeds) if args.seeds else [1, 2]
         except ValueError:
             seeds = []
         if not seeds:
             parser.error(f"--seeds must be A-B (A ≤ B) or A,B,…; got {args.seeds!r}")
-        return sweep(names, seeds)
+        if args.variants:
+            jobs = [(label, seed, dataclasses.replace(lg.SCENARIOS[name], seed=seed, **changes))
+                    for label, (name, changes) in VARIANTS.items() if name in names for seed in seeds]
+        else:
+            jobs = [(name, seed, dataclasses.replace(lg.SCENARIOS[name], seed=seed)) for name in names for seed in seeds]
+        return sweep(jobs)
     cards = []
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="scorecard-") as folder:
