@@ -40,11 +40,11 @@ import numpy as np
 from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, PulseSummary, Verdict, claimed_parent,
-                                         expected_rebound, from_indices, hidden_rebound, judge, judge_unmeasured,
-                                         landed_with_rebound, likeliest_hidden, rebound_of_a_rebound, rebounds_due,
-                                         rebounds_landed_together, refine, shape_table, too_light_for_fruit,
-                                         unmeasured_fruit)
+from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
+                                         Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
+                                         judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
+                                         rebound_of_a_rebound, rebounds_due, rebounds_landed_together, refine,
+                                         shape_table, too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -334,7 +334,7 @@ class LineAnalyzer:
             orphan = too_light_for_fruit(summary, self._lane_fruit(impact.lane))
         slow_parent = False
         if not rebound and status == "ok" and summary is not None and together is None and pair is None \
-                and orphan is None:
+                and orphan is None and not piece and self._quiet_fruit(impact.lane) < QUIET_LANE_FRUIT:
             # perhaps the bounce of a rebound that was itself taken for a fruit (its parent hidden in an overlap)
             own = {fruit.sequence for fruit in self._fruit.get(impact.lane, [])}
             slow = rebound_of_a_rebound(summary, [p for p in reversed(history) if p.sequence in own],
@@ -404,7 +404,13 @@ class LineAnalyzer:
             history[:] = recent[-8:]
         if not rebound and status != "overlap":
             self._last_fruit[impact.lane] = report["start_time"]
-        self._tally.setdefault(impact.lane, [0, 0])[1 if rebound else 0] += status != "overlap" or rebound
+        # the lane's tally: a rebound, a pulse holding rebounds, or a contact judged near a rebound (ambiguous) is
+        # evidence that the lane's fruit come back; a fruit measured as one, that they may not
+        tally = self._tally.setdefault(impact.lane, [0, 0])
+        if rebound or together is not None or pair is not None or (chosen is not None and chosen.ambiguous):
+            tally[1] += 1
+        elif status != "overlap":
+            tally[0] += 1
         if pair is not None:  # both rebounds are seen, and each may bounce again from here
             for parent in pair_parents:
                 index = next((i for i, s in enumerate(history) if s is parent), None)

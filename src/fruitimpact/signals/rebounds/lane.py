@@ -456,8 +456,12 @@ def rebound_of_a_rebound(candidate: PulseSummary, parents: list[PulseSummary], f
       V_p = u/r; as a share q = V_p/V of the line's speed it must be a rebound's (``SLOW_PARENT_RATIO``);
     * as a new fruit of the lane at V it is improbable: its restitution, impulse and contact stiffness read at V
       lie beyond the 99 % point of χ² with three degrees of freedom from the lane's measured ``fruit`` (at least
-      ``LANE_FRUIT_MIN``; ``_as_lane_rebound``).  A lighter new fruit can mimic a rebound's pulse only with a
-      stiffness r^-1.5 times lower as well, which the lot's spread of stiffness does not allow.
+      ``LANE_FRUIT_MIN``; ``_as_lane_rebound``);
+    * and the parent itself looks like what the flight says it was: a rebound of a lane fruit at q V explains its
+      restitution, impulse and stiffness (read at q V) at least as well as a fruit of the lane at V does (the
+      lane's other fruit, at least ``LANE_FRUIT_MIN``).  Without this a soft, light, lively new fruit landing
+      after a fruit measured as the fruit it was passed the tests above (a lighter fruit mimics a rebound's pulse
+      when it is also r^1.5 times softer: 0.6 of the mass and 0.5–0.7 of the stiffness, a lot's soft tail).
 
     Then the candidate is that parent's rebound, marked ambiguous, with the evidence (the parent's speed read
     from the flight; the parent's grade, already given, is not revised).  The nearest such parent on the tests
@@ -474,26 +478,41 @@ def rebound_of_a_rebound(candidate: PulseSummary, parents: list[PulseSummary], f
         if parent.rebound_taken or parent.velocity is None or not 0.0 < flight <= max_flight:
             continue
         evidence = _hypothesis(candidate, parent)
-        shared = max(v for k, v in evidence["deviations"].items() if k != "flight" and v is not None)
-        if any(v is None for k, v in evidence["deviations"].items() if k != "flight") or shared > 1.0:
+        shared_tests = [v for k, v in evidence["deviations"].items() if k != "flight"]
+        if not shared_tests or any(v is None for v in shared_tests) or max(shared_tests) > 1.0:
             continue
+        shared = max(shared_tests)
         r = evidence["speed_ratio"]
         landing = STANDARD_GRAVITY * flight / 2.0
         share = landing / r / velocity
         if not SLOW_PARENT_RATIO[0] <= share <= SLOW_PARENT_RATIO[1]:
             continue
+        # the parent itself must look like what the flight says it was: a rebound at share × V explains its
+        # restitution, impulse and stiffness (read at that speed) at least as well as a fruit of the lane at V does.
+        # A fruit that was measured as the fruit it is fails this (read at 0.6 V it needs a fruit 2.2 times stiffer
+        # than the lot), so a soft, light, lively new fruit landing after it is not taken for its rebound
+        others = [f for f in fruit if (f.sequence, f.onset) != (parent.sequence, parent.onset)]
+        if len(others) < LANE_FRUIT_MIN:
+            continue
+        as_parent = _as_lane_rebound(parent, others, lane_fruit(others), velocity, share)
+        if not as_parent["rebound2"] <= as_parent["new_fruit2"]:
+            continue
         if best is None or shared < best[0]:
-            best = (shared, parent, evidence, share, landing)
+            best = (shared, parent, evidence, share, landing, as_parent)
     if best is None:
         return NEW_FRUIT
-    shared, parent, evidence, share, landing = best
+    shared, parent, evidence, share, landing, as_parent = best
     evidence.update(score=round(shared, 3), threshold=1.0, landing_speed=landing, parent_speed=share * velocity,
                     parent_speed_share=round(share, 3), new_fruit_distance=round(math.sqrt(as_fruit), 3),
+                    parent_rebound_distance=round(math.sqrt(as_parent["rebound2"]), 3),
+                    parent_fruit_distance=round(math.sqrt(as_parent["new_fruit2"]), 3),
                     kind="rebound_of_a_rebound",
                     reason=(f"the same fruit as #{parent.sequence} (speed ratio, peak force, time to peak and shape "
                             f"within {shared:.2f} of their tolerances) but landing {_flight_text(evidence)}: "
                             f"#{parent.sequence} moved at {share:.2f} of the line's speed, so it was itself a "
-                            f"rebound (taken for a fruit, its grade given); as a new fruit this contact lies "
+                            f"rebound (taken for a fruit, its grade given; as such a rebound it lies "
+                            f"{math.sqrt(as_parent['rebound2']):.1f} sd from the lane's fruit, as a fruit "
+                            f"{math.sqrt(as_parent['new_fruit2']):.1f}); as a new fruit this contact lies "
                             f"{math.sqrt(as_fruit):.1f} sd from the lane's fruit"))
     return Verdict(True, parent.sequence, True, evidence["speed_ratio"], evidence)
 
