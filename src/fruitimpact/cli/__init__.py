@@ -54,10 +54,29 @@ def _note_interrupts() -> None:
 
     def interrupt(signum, frame):
         _SIGNALLED.append(signum)
-        raise KeyboardInterrupt
+        _deliver_interrupt(signum, frame)
 
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not when SIGINT is ignored (nohup, &)
         signal.signal(signal.SIGINT, interrupt)
+
+
+#: The import system's own frames: a Ctrl-C is not raised inside them (``_deliver_interrupt``).
+IMPORT_SYSTEM = ("<frozen importlib._bootstrap>", "<frozen importlib._bootstrap_external>")
+
+
+def _deliver_interrupt(signum, frame) -> None:
+    """Raise the KeyboardInterrupt of a Ctrl-C, unless the main thread is inside the import system's own code
+    (``IMPORT_SYSTEM``): there it can escape the lock bookkeeping as a traceback printed before the one line
+    (seen once in a fresh-clone CI run: raised in ``_lock_unlock_module``'s ``release``, 24 SIGINTs into
+    `simulate`'s start-up under load) or leave a module's lock held.  It is then delivered again 5 ms later by a
+    one-shot timer (SIGALRM, as ``_redeliver_interrupts_from_callbacks`` does), by then back in ordinary code."""
+    import signal
+
+    if frame is not None and frame.f_code.co_filename in IMPORT_SYSTEM and hasattr(signal, "setitimer"):
+        signal.signal(signal.SIGALRM, _deliver_interrupt)
+        signal.setitimer(signal.ITIMER_REAL, 0.005)
+        return
+    raise KeyboardInterrupt
 
 
 #: Callbacks in which a Ctrl-C was swallowed.  numba's compiler then fails on its own (a cache that never
@@ -78,13 +97,10 @@ def _redeliver_interrupts_from_callbacks() -> None:
         return
     default_hook = sys.unraisablehook
 
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
     def hook(unraisable):
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
             _SWALLOWED.append(unraisable.object)
-            signal.signal(signal.SIGALRM, interrupt)
+            signal.signal(signal.SIGALRM, _deliver_interrupt)
             signal.setitimer(signal.ITIMER_REAL, 0.005)
             return
         default_hook(unraisable)
