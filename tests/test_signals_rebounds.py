@@ -1049,14 +1049,27 @@ def test_analyze_says_the_speed_it_read_from_the_rebounds(cli, tmp_path):
 
 
 def test_a_fruits_flight_measures_the_speed_it_lands_at():
-    """A body leaving a plate at u rises and falls back in 2 u/g (vertical projectile motion, drag neglected; spin
-    and an off-axis bounce change its path, not the vertical motion the flight time measures), so it lands at
-    u = g · flight/2: the analysis's ``ballistic_speed``, to rounding.  No flight, no speed."""
-    from fruitimpact.signals.analysis import ballistic_speed
+    """The flight of a body leaving a plate at u, integrated by SciPy (z'' = −g from z = 0, ż = u, until z returns
+    to 0; drag neglected; spin and an off-axis bounce change the path, not this vertical motion): its time in the
+    air is ``flight_time(u)`` and the speed it lands at is ``landing_speed`` of that time, to the integrator's
+    tolerance (rtol 1e-12).  No flight, no speed."""
+    from scipy.integrate import solve_ivp
 
+    from fruitimpact.signals.rebounds import flight_time, landing_speed
+
+    def ground(t, y):
+        return y[0]
+
+    ground.terminal, ground.direction = True, -1
     for u in (0.05, 0.4, 1.3):
-        assert ballistic_speed(2.0 * u / G) == pytest.approx(u, rel=1e-12)
-    assert math.isnan(ballistic_speed(0.0)) and math.isnan(ballistic_speed(-0.01))
+        sol = solve_ivp(lambda t, y: [y[1], -G], (0.0, 10.0), [0.0, u], events=ground, rtol=1e-12, atol=1e-15,
+                        first_step=1e-6)
+        flight, landed = sol.t_events[0][0], -sol.y_events[0][0][1]
+        assert flight_time(u) == pytest.approx(flight, rel=1e-9)
+        assert landing_speed(flight) == pytest.approx(landed, rel=1e-9)
+        assert landed == pytest.approx(u, rel=1e-9)
+    assert math.isnan(landing_speed(0.0)) and math.isnan(landing_speed(-0.01))
+    assert math.isnan(landing_speed(math.nan))
 
 
 def _a_rebound_taken_for_a_fruit(mass=1.3 * MASS, stiffness=1.4 * STIFFNESS, spin=0.95):
@@ -1170,7 +1183,7 @@ def test_a_lane_that_has_shown_no_rebound_needs_a_clear_one():
     parent, clear, *_ = fruit_and_rebound()
     assert judge(clear, [parent], max_flight=1.0, quiet_fruit=5 * QUIET_LANE_FRUIT).rebound
     analyzer = Analysis(RATE, fit=True, velocity=V_LINE).analyzer()
-    analyzer._tally = {0: [12, 0], 1: [12, 1]}
+    analyzer._quiet = {0: 12, 1: None}  # lane 1 has shown a rebound
     assert analyzer._quiet_fruit(0) == 12 and analyzer._quiet_fruit(1) == 0 and analyzer._quiet_fruit(2) == 0
 
 

@@ -37,14 +37,14 @@ import math
 import numpy as np
 
 
-from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
                                          Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
                                          judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         rebound_of_a_rebound, rebounds_due, rebounds_landed_together, refine,
-                                         shape_table, too_light_for_fruit, unmeasured_fruit)
+                                         landing_speed, rebound_of_a_rebound, rebounds_due,
+                                         rebounds_landed_together, refine, shape_table, too_light_for_fruit,
+                                         unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
@@ -106,8 +106,8 @@ class LineAnalyzer:
         self._fruit: dict[int, list[PulseSummary]] = {}
         #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
-        #: per lane: [new fruit, rebounds] reported so far (``_quiet_fruit``)
-        self._tally: dict[int, list[int]] = {}
+        #: per lane: fruit reported while the lane has shown no sign of a rebound; None once it has (``_quiet_fruit``)
+        self._quiet: dict[int, int | None] = {}
         #: per lane: the impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
         self._speeds: dict[int, list[float]] = {}
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
@@ -364,7 +364,7 @@ class LineAnalyzer:
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
             self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
-            landing = ballistic_speed(chosen.evidence["flight_observed"])
+            landing = landing_speed(chosen.evidence["flight_observed"])
         elif rebound and slow_parent:  # its parent was a rebound taken for a fruit: no longer one of the lane's fruit
             index = claimed_parent(summary, history, chosen.parent)
             history[index] = history[index].taken()
@@ -406,11 +406,10 @@ class LineAnalyzer:
             self._last_fruit[impact.lane] = report["start_time"]
         # the lane's tally: a rebound, a pulse holding rebounds, or a contact judged near a rebound (ambiguous) is
         # evidence that the lane's fruit come back; a fruit measured as one, that they may not
-        tally = self._tally.setdefault(impact.lane, [0, 0])
         if rebound or together is not None or pair is not None or (chosen is not None and chosen.ambiguous):
-            tally[1] += 1
-        elif status != "overlap":
-            tally[0] += 1
+            self._quiet[impact.lane] = None
+        elif status != "overlap" and self._quiet.get(impact.lane, 0) is not None:
+            self._quiet[impact.lane] = self._quiet.get(impact.lane, 0) + 1
         if pair is not None:  # both rebounds are seen, and each may bounce again from here
             for parent in pair_parents:
                 index = next((i for i, s in enumerate(history) if s is parent), None)
@@ -450,8 +449,7 @@ class LineAnalyzer:
     def _quiet_fruit(self, lane: int) -> int:
         """How many fruit ``lane`` has reported without a single rebound (0 once it has shown one): a lane that
         stops its fruit (``rebounds.QUIET_LANE_FRUIT``)."""
-        fruit, rebounds = self._tally.get(lane, (0, 0))
-        return 0 if rebounds else fruit
+        return self._quiet.get(lane, 0) or 0
 
     def reads_speed(self) -> bool:
         """Whether the impact speed is read from the rebounds: neither given nor found by each fit (the mass
@@ -483,7 +481,7 @@ class LineAnalyzer:
         flight = rebound.onset - parent.separation
         if flight > 0 and verdict.speed_ratio > 0:
             kept = self._speeds.setdefault(lane, [])
-            kept.append(STANDARD_GRAVITY * flight / (2.0 * verdict.speed_ratio))
+            kept.append(landing_speed(flight) / verdict.speed_ratio)
             del kept[:-SPEED_KEPT]
 
     def _lane_fruit(self, lane: int) -> list[PulseSummary]:
@@ -525,13 +523,6 @@ class LineAnalyzer:
 #: the same for every rate, and its cost grows with the rate (13 s at 10 MHz), so it runs once, at this rate.
 WARM_RATE = 20_000.0
 _WARM: list = []
-
-
-def ballistic_speed(flight: float) -> float:
-    """The speed [m/s] at which a fruit that left the plate lands on it again after ``flight`` [s] in the air:
-    u = g · flight / 2 (a ballistic flight between two points at one height, drag neglected; spin and an off-axis
-    bounce change the path, not the vertical motion that the flight time measures).  NaN for a flight ≤ 0."""
-    return STANDARD_GRAVITY * flight / 2.0 if _finite(flight) and flight > 0 else math.nan
 
 
 def _warm_up(analysis: Analysis) -> None:

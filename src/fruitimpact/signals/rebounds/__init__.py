@@ -61,13 +61,14 @@ from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATI
                                                    QUIET_LANE_FRUIT, claimed_parent, expected_rebound,
                                                    hidden_rebound, judge, likeliest_hidden, rebounds_due)
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
-                                                 from_indices, refine, shape_table)
+                                                 flight_time, from_indices, landing_speed, refine, shape_table)
 
 __all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
            "HIDDEN_FRUIT_MIN",
            "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
            "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
            "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",
-           "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit", "likeliest_hidden",
+           "flight_time", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
+           "landing_speed", "likeliest_hidden",
            "rebound_of_a_rebound", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
            "too_light_for_fruit", "unmeasured_fruit"]

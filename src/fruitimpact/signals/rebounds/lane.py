@@ -10,10 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fruitimpact.physics.constants import STANDARD_GRAVITY
 from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
                                                      _hypothesis, _rebound_pulse)
-from fruitimpact.signals.rebounds.pulses import AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at
+from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at,
+                                                 flight_time, landing_speed)
 
 
 def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, velocity: float) -> PulseSummary:
@@ -391,7 +391,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     duration = float(np.median([f.separation - f.onset for f in fruit]))
     shared = _as_lane_rebound(candidate, fruit, lane, velocity, EXPECTED_RATIO * lane.restitution)
     r, r_sd = shared["r"], shared["r_sd"]
-    flight_pred = 2.0 * r * velocity / STANDARD_GRAVITY
+    flight_pred = flight_time(r * velocity)
     flight = candidate.onset - (hidden_onset + duration)
     deviations = dict(shared["deviations"])
     deviations["flight"] = abs(math.log(flight / flight_pred)) / math.hypot(tol["flight"], r_sd) \
@@ -483,7 +483,7 @@ def rebound_of_a_rebound(candidate: PulseSummary, parents: list[PulseSummary], f
             continue
         shared = max(shared_tests)
         r = evidence["speed_ratio"]
-        landing = STANDARD_GRAVITY * flight / 2.0
+        landing = landing_speed(flight)
         share = landing / r / velocity
         if not SLOW_PARENT_RATIO[0] <= share <= SLOW_PARENT_RATIO[1]:
             continue

@@ -7,8 +7,8 @@ from __future__ import annotations
 import math
 
 
-from fruitimpact.physics.constants import STANDARD_GRAVITY
-from fruitimpact.signals.rebounds.pulses import AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at
+from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at,
+                                                 flight_time)
 
 
 def _speed_ratio(candidate: PulseSummary, parent: PulseSummary) -> float:
@@ -47,7 +47,7 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
                 "peak_observed": candidate.peak_force, "peak_predicted": peak_pred, "speed_ratio": r,
                 "restitution_parent": parent.restitution}
     if parent.velocity is not None and not parent.speed_read:
-        predicted = 2.0 * r * parent.velocity / STANDARD_GRAVITY
+        predicted = flight_time(r * parent.velocity)
         evidence["flight_predicted"] = predicted
         deviations["flight"] = abs(math.log(flight / predicted)) / math.hypot(tol["flight"], r_sd) \
             if flight > 0 else math.inf
@@ -134,7 +134,7 @@ def rebounds_due(onset: float, end: float, earlier: list[PulseSummary], *, max_f
             continue
         if onset - parent.separation > max_flight:
             continue
-        flight = 2.0 * parent.restitution * parent.velocity / STANDARD_GRAVITY
+        flight = flight_time(parent.restitution * parent.velocity)
         lo = parent.separation + flight * (1.0 - tol["speed_ratio"]) * (1.0 - tol["flight"])
         hi = parent.separation + flight * (1.0 + tol["speed_ratio_up"]) * (1.0 + tol["flight"])
         if lo <= end and onset <= hi:
@@ -180,7 +180,7 @@ def likeliest_hidden(due: list[PulseSummary], onset: float) -> PulseSummary | No
     """Of the contacts whose rebound was due in an overlap starting at ``onset`` [s], the one whose rebound was
     predicted to land nearest it (in units of its flight): an overlap holds at most one hidden rebound."""
     def miss(p: PulseSummary) -> float:  # how far its predicted landing lies from the onset, in flights
-        flight = 2.0 * EXPECTED_RATIO * p.restitution * p.velocity / STANDARD_GRAVITY
+        flight = flight_time(EXPECTED_RATIO * p.restitution * p.velocity)
         return abs(onset - (p.separation + flight)) / flight
 
     timed = [p for p in due if p.velocity is not None and p.velocity > 0 and p.restitution > 0]

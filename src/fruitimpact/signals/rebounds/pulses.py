@@ -9,6 +9,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from fruitimpact.physics.constants import STANDARD_GRAVITY
+
+
+def flight_time(speed: float) -> float:
+    """The time [s] a fruit leaving the plate at ``speed`` [m/s] spends in the air before it lands on it again:
+    2 V/g (a ballistic flight between two points at one height, drag neglected; spin and an off-axis bounce change
+    the path, not the vertical motion)."""
+    return 2.0 * speed / STANDARD_GRAVITY
+
+
+def landing_speed(flight: float) -> float:
+    """The speed [m/s] at which a fruit lands again after ``flight`` [s] in the air, g · flight/2 (the inverse of
+    ``flight_time``); NaN for a flight that is not > 0."""
+    return STANDARD_GRAVITY * flight / 2.0 if math.isfinite(flight) and flight > 0 else math.nan
 
 
 #: Tolerances of the tests (the package docstring): relative flight and speed ratio, the model part of the
