@@ -23,6 +23,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_common import console_script, machine  # noqa: E402
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
 
 def best(func, repeats: int, number: int) -> float:
     """Best time of one call [s] over ``repeats`` runs of ``number`` calls."""
@@ -73,6 +75,10 @@ def main() -> None:
         ("population --fruit pear --criterion shear (usage)",
          wall([exe, "population", "-n", "10", "--fruit", "pear", "--criterion", "shear"]), "s", "python -c pass", bare,
          "", "≤ 0.25 s"),
+        ("sphere LOG --method rk4 --step 1s (usage)",
+         wall([exe, "sphere", str(EXAMPLES / "sphere-log.csv"), "--sphere", "is-1987", "--sphere-calibration",
+               str(EXAMPLES / "sphere-calibration.csv"), "--fruit", "apple", "--method", "rk4", "--step", "1s"]), "s",
+         "python -c pass", bare, "", "≤ 0.25 s"),
         ("fruitimpact simulate (warm cache)", wall([exe, "simulate"], 5), "s", "python -c pass", bare, "",
          "≤ 0.4 s"),
     ]

@@ -772,7 +772,10 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     (["population", "--mass", "sample(fruit.csv:model)"], "argument --mass: sample: column 'model': cannot read"),
     (["population", "--mass", "sample(ragged.csv:mass)"], "argument --mass: sample: line 3 of 'ragged.csv' has 1"),
     # a step refused for every fruit of the lot (it ran every row invalid and exited 0)
-    (["population", "-n", "100", "--method", "rk4", "--step", "1s"], "every one of the lot's 100 fruit")])
+    (["population", "-n", "100", "--method", "rk4", "--step", "1s"], "every one of the lot's 100 fruit"),
+    # a step no fruit can take at the points of a sphere's log (0.9 s: the calibration's fit and the inversion)
+    (["sphere", "LOG", "--sphere", "is-1987", "--sphere-calibration", "CAL", "--fruit", "apple", "--method", "rk4",
+      "--step", "1s"], "argument --step: step must be at most 1/20 of the contact duration for rk4")])
 def test_a_usage_error_about_a_file_or_a_lot_loads_neither_numba_nor_pandas(argv, line, tmp_path):
     """Issue 15 item 4 (≤ 0.25 s): pandas alone takes 0.3 s to import; these refusals need neither it nor numba."""
     imported = _refusal_imports(argv, line, tmp_path)
@@ -780,7 +783,7 @@ def test_a_usage_error_about_a_file_or_a_lot_loads_neither_numba_nor_pandas(argv
 
 
 def _refusal_imports(argv, line, tmp_path) -> set:
-    """The modules the console script imported to refuse ``argv`` (LINE, LOG, REC, fruit.csv and ragged.csv
+    """The modules the console script imported to refuse ``argv`` (LINE, LOG, CAL, REC, fruit.csv and ragged.csv
     stand for files made here) with one line holding ``line``, exit 2."""
     import os
     import shutil
@@ -795,7 +798,9 @@ def _refusal_imports(argv, line, tmp_path) -> set:
     shutil.copy(examples / "fruit.csv", tmp_path / "fruit.csv")
     (tmp_path / "ragged.csv").write_text("mass,velocity\n0.1,1\n0.12\n")
     (tmp_path / "rec.csv").write_text("time [s],force [N]\n" + "".join(f"{k / 1000:.3f},0.0\n" for k in range(100)))
-    files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv"), "REC": str(tmp_path / "rec.csv")}
+    shutil.copy(examples / "sphere-calibration.csv", tmp_path / "sphere-calibration.csv")
+    files = {"LINE": str(tmp_path / "line.csv"), "LOG": str(tmp_path / "sphere-log.csv"), "REC": str(tmp_path / "rec.csv"),
+             "CAL": str(tmp_path / "sphere-calibration.csv")}
     argv = [files.get(a, a) for a in argv]
     env = {**os.environ, "PYTHONPROFILEIMPORTTIME": "1"}
     done = subprocess.run([console_script(), *argv], capture_output=True, text=True, cwd=tmp_path, env=env,

@@ -513,3 +513,26 @@ def test_the_charts_incidence_lines_are_where_the_lot_bruises_at_that_fraction(t
             assert found == pytest.approx(fraction, abs=tolerance), (fraction, point, found)
         changes = [p["velocity_change"] for p in line]
         assert all(a >= b for a, b in zip(changes, changes[1:])), changes  # softer first: larger ΔV
+
+
+def test_an_rk4_step_refused_before_the_inversion_is_one_the_rows_refuse_too():
+    """Issue 15 item 4: ``sphere --method rk4 --step 1s`` is refused before the calibration's fit and the
+    inversion load the compiled pulse table (0.9 s before), from a bound on the longest contact any fruit of the
+    lot can have at the log's points (``spheres.audit._refuse_coarse_step``).  The bound must be loose, never
+    tight: a step just below it reaches the rows, and the rows' own check (1/20 of each fruit's Hertz duration,
+    ``solvers.max_rk4_step``) refuses every fruit for it at every point — so no step the rows would take is
+    refused early.  The shipped example log (made by SciPy, not by fruitimpact; a 2 MPa chute is its softest
+    point)."""
+    from pathlib import Path
+
+    from fruitimpact.spheres.audit import sphere_audit
+
+    examples = Path(__file__).parents[1] / "examples"
+    options = dict(sphere="is-1987", sphere_calibration=str(examples / "sphere-calibration.csv"), fruit="apple",
+                   method="rk4", rows=200, bruise_width_ratio=1.4)
+    with pytest.raises(ValueError, match="no fruit of the lot has a contact longer than") as refused:
+        sphere_audit(str(examples / "sphere-log.csv"), step="1s", **options)
+    bound = float(re.search(r"at most ([0-9.e+-]+) s\)", str(refused.value)).group(1))
+    with pytest.raises(ValueError, match="step must be at most 1/20 of the contact duration") as rows:
+        sphere_audit(str(examples / "sphere-log.csv"), step=f"{bound * 0.98:.6g}s", **options)
+    assert "no fruit of the lot" not in str(rows.value)

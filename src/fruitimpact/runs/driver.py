@@ -67,7 +67,8 @@ class TableWriter:
 
                 self.writer = pacsv.CSVWriter(self.path, table.schema,
                                               write_options=pacsv.WriteOptions(quoting_style="needed"))
-        for part in slices(table):  # an interrupted run's writer stops between slices (``runs.abandon``)
+        # an interrupted run's writer stops between slices (``runs.abandon``)
+        for part in slices(table, text=self.format == "csv"):
             self.writer.write_table(part)
 
     def close(self) -> None:

@@ -224,6 +224,9 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
     read_lot(inputs, rows=1, seed=seed, spreads=spreads, criterion=criterion,
              excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
              excluded_reason="is set by each transfer point the sphere measured")
+    # before the calibration's fit (the compiled pulse table): the bound needs the sphere's mass and size only
+    _refuse_coarse_step(inputs, rows, seed, spreads, criterion, probe if sphere_calibration is not None else body,
+                        readings, readings.sample_period or (1.0 / rate if rate else 0.0))
     if sphere_calibration is not None:
         try:
             calibration = read_calibration(sphere_calibration, probe.mass, probe.diameter, table=table)
@@ -411,6 +414,58 @@ def sphere_audit(log, *, sphere: str | None = None, sphere_mass=None, sphere_dia
         "spreads": report.get("spreads"), "inputs": report.get("inputs"),
         "warnings": warnings + report["warnings"], "status": status, "message": message,
     }
+
+
+#: Margin on a logged contact duration in the step bound below: a duration read from a threshold crossing, or a
+#: damped contact, may differ from the Hertz duration of the same stiffness by tens of percent; 1.5 in T is 2.8 in
+#: stiffness, so the bound can only be loose, never tight.
+DURATION_MARGIN = 1.5
+
+
+def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, period) -> None:
+    """Refuse, before the inversion (the compiled pulse table, ~0.6 s), an rk4 step that every fruit of the lot
+    would be refused for at every point the log measured: the step above 1/20 of the longest Hertz contact
+    duration any fruit can have there (``solvers.max_rk4_step``'s rule).
+
+    The bound holds whatever the inversion finds.  Each reading's surface is at least as stiff as the sphere saw it:
+    the sphere's Hertz stiffness from its duration (lengthened by ``DURATION_MARGIN`` and half a logger period) at
+    the fastest landing its velocity change allows (V_in = ΔV, e → 0) bounds E*_sw from below, and E'_w ≥ E*_sw.
+    The fruit lands at least at ΔV/2 (e ≤ 1) of the slowest reading, with its own modulus and ν = 0 (the softest).
+    A step that some fruit may meet is left to the rows (the exact check after the inversion)."""
+    from fruitimpact.handling.heights import AXIS_INPUTS
+    from fruitimpact.impact.lots import read_lot
+    from fruitimpact.impact.solvers import RK4_MIN_STEPS_PER_CONTACT
+    from fruitimpact.impact.validation import InputError
+    from fruitimpact.physics.hertz import effective_modulus, hertz_contact_duration, hertz_stiffness
+
+    if inputs.get("step") is None or str(inputs.get("method", "")).strip().lower() != "rk4" \
+            or inputs.get("stiffness") is not None:
+        return
+    timed = np.isfinite(readings.duration) & (readings.duration > 0) & np.isfinite(readings.change) \
+        & (readings.change > 0)
+    if not timed.any():
+        return
+    source, _, _ = read_lot(inputs, rows=rows, seed=seed, spreads=spreads, criterion=criterion,
+                            excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
+                            excluded_reason="is set by each transfer point the sphere measured")
+    columns = source.inputs(0, rows, None)[0]
+    if not all(isinstance(columns.get(name), np.ndarray) for name in ("step", "mass", "diameter", "modulus")):
+        return
+    longest = (readings.duration[timed] + period / 2.0) * DURATION_MARGIN
+    change = readings.change[timed]
+    # T ∝ K^(-2/5) at given m and v: the stiffness whose Hertz duration is the longest reading, at V_in = ΔV
+    sphere_stiffness = (hertz_contact_duration(body.mass, 1.0, change) / longest) ** 2.5
+    surface = float(np.min(sphere_stiffness / hertz_stiffness(1.0, body.diameter / 2.0)))  # E*_sw [Pa]
+    fruit_modulus = effective_modulus(columns["modulus"], 0.0, surface, 0.0)
+    duration = hertz_contact_duration(columns["mass"], hertz_stiffness(fruit_modulus, columns["diameter"] / 2.0),
+                                      float(np.min(change)) / 2.0)
+    bound = duration / RK4_MIN_STEPS_PER_CONTACT
+    step = columns["step"]
+    if np.all(step > bound):
+        raise InputError(f"step must be at most 1/20 of the contact duration for rk4 (at least "
+                         f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact); got {float(np.max(step)):.6g} s, and no "
+                         f"fruit of the lot has a contact longer than {float(np.max(duration)) * 1e3:.3g} ms at the "
+                         f"points this log measured (at most {float(np.max(bound)):.3g} s)", "step")
 
 
 def _advice(point: str, incidence: float, target: float, changes: list, cushions: list) -> dict | None:
