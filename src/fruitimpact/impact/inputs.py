@@ -63,6 +63,8 @@ def check_columns(names) -> dict[str, object]:
 class InputColumns:
     """Inputs of ``rows`` impacts: ``values[name]`` float64 [SI] (NaN where not given or
     unreadable), ``given[name]`` bool, ``text[name]`` ``Labels`` (defaults filled in).
+    ``evaluation`` writes each input's default into its own row where it was not given (the
+    inputs as used, without a fresh column each): read ``values`` where ``given`` only.
 
     The numeric inputs are rows of one matrix, ``matrix`` (inputs × rows, in the order of
     ``quantities.NUMERIC_INPUTS``) with ``given_matrix`` beside it: the range checks of

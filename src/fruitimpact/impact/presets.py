@@ -49,10 +49,10 @@ class Resolved:
     impact_basis: dict
 
     def apply(self, used: dict, given: dict) -> None:
-        """Replace the table defaults in ``used`` (name → array) where the input was not given."""
+        """Replace the table defaults in ``used`` (name → array, written in place) where the input was not given."""
         for name, value in self.defaults.items():
             if not np.all(given[name]):
-                used[name] = np.where(given[name], used[name], value)
+                np.copyto(used[name], value, where=~given[name])
 
 
 class _Defaults(dict):
