@@ -1315,3 +1315,27 @@ def test_a_hidden_fruits_rebound_carries_the_speed_its_flight_shows():
         assert kept.velocity == pytest.approx(back["V"], rel=0.03)
         assert second["rebound"] and second["rebound_of"] == rebound["sequence"], second["rebound_evidence"]
         assert second["mass"] == pytest.approx(MASS, rel=0.05)
+
+
+def test_a_rebound_found_to_have_been_one_gives_the_feed_prior_its_last_fruit_back():
+    """With the feed known (--pitch), each contact is judged against the phase of the lane's last fruit.  A rebound
+    taken for a fruit moved that phase to its own onset, off the pitch; once its bounce shows it was a rebound
+    (``rebound_of_a_rebound``, found by a review), the fruit before it is the last fruit again, so a fruit landing
+    one pitch after that one is on the pitch (the stricter rebound threshold 0.8), not 0.45 pitch off it.  Its
+    grade stands (not revised).  A fruit landed since keeps its place."""
+    from fruitimpact.signals.rebounds.measured import _threshold
+
+    pitch = 0.125
+    analyzer = Analysis(RATE, fit=True, velocity=V_LINE, pitch=pitch).analyzer()
+    analyzer._last_fruit = {0: 1.0 + 0.055}
+    analyzer._fruit_onsets = {0: [(4, 1.0 - pitch), (6, 1.0), (7, 1.0 + 0.055)]}  # #7: a rebound taken for a fruit
+    next_fruit = summary(impact(), 1.0 + pitch, 9)
+    assert _threshold(next_fruit, analyzer._last_fruit[0], pitch)[0] == 1.25  # 0.56 pitch after #7: off the pitch
+    analyzer._not_a_fruit(0, 7)
+    assert analyzer._last_fruit[0] == 1.0 and analyzer._fruit_onsets[0][-1] == (6, 1.0)
+    assert _threshold(next_fruit, analyzer._last_fruit[0], pitch)[0] == 0.8  # one pitch after #6: on it
+    analyzer._not_a_fruit(0, 4)  # not the last fruit any more: nothing changes
+    assert analyzer._last_fruit[0] == 1.0
+    analyzer._not_a_fruit(0, 6)
+    analyzer._not_a_fruit(0, 4)
+    assert 0 not in analyzer._last_fruit

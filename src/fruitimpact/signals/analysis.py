@@ -99,7 +99,10 @@ class LineAnalyzer:
     def __init__(self, analysis: Analysis):
         self.analysis = analysis
         self._history: dict[int, list[PulseSummary]] = {}
+        #: per lane: the onset [s] of the last contact taken for a fruit (the feed prior's phase), and the recent
+        #: ones as (sequence, onset), so that a contact found later to have been a rebound gives its place back
         self._last_fruit: dict[int, float] = {}
+        self._fruit_onsets: dict[int, list[tuple[int, float]]] = {}
         #: per lane: (sequence, onset [s], end [s]) of recent contacts that could not be measured (overlaps)
         self._unmeasured: dict[int, list[tuple]] = {}
         #: per lane: the recent measured new fruit (the lot's typical pulse at the line's speed)
@@ -233,6 +236,19 @@ class LineAnalyzer:
             return sorted([*parts[:k], *again, *parts[k + 1:]], key=lambda part: part[1]["start_time"])
         return parts
 
+    def _not_a_fruit(self, lane: int, sequence: int) -> None:
+        """Contact ``sequence`` of ``lane``, taken for a fruit, was a rebound (``rebound_of_a_rebound``): its grade
+        stands, but the feed prior's last fruit is again the one before it (a rebound's onset is off the feed's
+        pitch, and would move the phase every later contact is judged by)."""
+        onsets = self._fruit_onsets.get(lane, [])
+        if not onsets or onsets[-1][0] != sequence:
+            return  # a fruit has landed since: the last fruit is that one
+        onsets.pop()
+        if onsets:
+            self._last_fruit[lane] = onsets[-1][1]
+        else:
+            self._last_fruit.pop(lane, None)
+
     def _rebounds(self, parts, noise: float) -> list[bool]:
         """Which pieces of a split are judged rebounds of earlier contacts of their lane, as ``_contact`` will
         judge them: ``rebounds.judge`` on each piece's own indices and fit, in time order, with the feed prior and
@@ -342,6 +358,7 @@ class LineAnalyzer:
                                         analysis.flight_limit)
             if slow.rebound:
                 chosen, rebound, hidden_fruit, slow_parent = slow, True, False, True
+                self._not_a_fruit(impact.lane, slow.parent)
         if orphan is not None:  # a rebound whose parent's pulse was not measured as it was: not graded
             if chosen is not None and chosen.evidence:  # a near miss of a known parent, kept as evidence
                 orphan["nearest_parent"] = chosen.evidence
@@ -404,6 +421,9 @@ class LineAnalyzer:
             history[:] = recent[-8:]
         if not rebound and status != "overlap":
             self._last_fruit[impact.lane] = report["start_time"]
+            onsets = self._fruit_onsets.setdefault(impact.lane, [])
+            onsets.append((sequence, report["start_time"]))
+            del onsets[:-4]
         # the lane's tally: a rebound, a pulse holding rebounds, or a contact judged near a rebound (ambiguous) is
         # evidence that the lane's fruit come back; a fruit measured as one, that they may not
         if rebound or together is not None or pair is not None or (chosen is not None and chosen.ambiguous):
