@@ -365,6 +365,10 @@ def test_the_line_audit_in_a_real_browser(server, tmp_path):
         view.set_viewport_size({"width": 700, "height": 1000})
         view.wait_for_timeout(200)
         assert view.evaluate("document.documentElement.scrollWidth") <= 700
+        # and the changes table fits its panel: its words and headings wrap, so each change's numbers and its
+        # "what if" button are in view without scrolling the table sideways
+        assert view.evaluate("(() => { const t = document.getElementById('changes'); "
+                             "return t.scrollWidth <= t.parentElement.clientWidth; })()")
         view.screenshot(path=str(screenshots(tmp_path) / "line-700.png"), full_page=True)
 
 
