@@ -1334,8 +1334,13 @@ def test_a_rebound_found_to_have_been_one_gives_the_feed_prior_its_last_fruit_ba
     analyzer._not_a_fruit(0, 7)
     assert analyzer._last_fruit[0] == 1.0 and analyzer._fruit_onsets[0][-1] == (6, 1.0)
     assert _threshold(next_fruit, analyzer._last_fruit[0], pitch)[0] == 0.8  # one pitch after #6: on it
-    analyzer._not_a_fruit(0, 4)  # not the last fruit any more: nothing changes
-    assert analyzer._last_fruit[0] == 1.0
+    analyzer._not_a_fruit(0, 4)  # not the last fruit any more: the last fruit stays, #4 is forgotten
+    assert analyzer._last_fruit[0] == 1.0 and analyzer._fruit_onsets[0] == [(6, 1.0)]
     analyzer._not_a_fruit(0, 6)
-    analyzer._not_a_fruit(0, 4)
     assert 0 not in analyzer._last_fruit
+    # a contact found to be a rebound while a later fruit is the last never comes back (found by a review)
+    analyzer._last_fruit = {0: 1.055}
+    analyzer._fruit_onsets = {0: [(4, 1.0 - pitch), (6, 1.0), (7, 1.055)]}
+    analyzer._not_a_fruit(0, 6)
+    analyzer._not_a_fruit(0, 7)
+    assert analyzer._last_fruit[0] == 1.0 - pitch

@@ -515,24 +515,55 @@ def test_the_charts_incidence_lines_are_where_the_lot_bruises_at_that_fraction(t
         assert all(a >= b for a, b in zip(changes, changes[1:])), changes  # softer first: larger ΔV
 
 
-def test_an_rk4_step_refused_before_the_inversion_is_one_the_rows_refuse_too():
+@pytest.mark.parametrize("points", [None, ("receiving-belt", "bin-filler")])
+def test_an_rk4_step_refused_before_the_inversion_is_one_the_rows_refuse_too(points, tmp_path):
     """Issue 15 item 4: ``sphere --method rk4 --step 1s`` is refused before the calibration's fit and the
     inversion load the compiled pulse table (0.9 s before), from a bound on the longest contact any fruit of the
     lot can have at the log's points (``spheres.audit._refuse_coarse_step``).  The bound must be loose, never
     tight: a step just below it reaches the rows, and the rows' own check (1/20 of each fruit's Hertz duration,
     ``solvers.max_rk4_step``) refuses every fruit for it at every point — so no step the rows would take is
     refused early.  The shipped example log (made by SciPy, not by fruitimpact; a 2 MPa chute is its softest
-    point)."""
+    point, so its bound is 3 times what the rows accept), and its two rigid points alone, where the bound is
+    tightest (0.54 ms against 0.39 ms accepted by the rows)."""
     from pathlib import Path
 
     from fruitimpact.spheres.audit import sphere_audit
 
     examples = Path(__file__).parents[1] / "examples"
+    log = examples / "sphere-log.csv"
+    if points is not None:
+        lines = log.read_text().splitlines()
+        header = next(k for k, line in enumerate(lines) if line.startswith("time,"))
+        log = tmp_path / "rigid-points.csv"
+        log.write_text("\n".join([lines[header]] + [line for line in lines[header + 1:]
+                                                     if line.split(",")[-1] in points]) + "\n")
     options = dict(sphere="is-1987", sphere_calibration=str(examples / "sphere-calibration.csv"), fruit="apple",
                    method="rk4", rows=200, bruise_width_ratio=1.4)
     with pytest.raises(ValueError, match="no fruit of the lot has a contact longer than") as refused:
-        sphere_audit(str(examples / "sphere-log.csv"), step="1s", **options)
+        sphere_audit(str(log), step="1s", **options)
     bound = float(re.search(r"at most ([0-9.e+-]+) s\)", str(refused.value)).group(1))
     with pytest.raises(ValueError, match="step must be at most 1/20 of the contact duration") as rows:
-        sphere_audit(str(examples / "sphere-log.csv"), step=f"{bound * 0.98:.6g}s", **options)
+        sphere_audit(str(log), step=f"{bound * 0.98:.6g}s", **options)
     assert "no fruit of the lot" not in str(rows.value)
+
+
+def test_an_rk4_step_is_not_refused_early_when_a_reading_has_no_duration(tmp_path):
+    """A reading without a duration (its restitution given) can put a point on a surface far softer than any timed
+    reading shows: here a timed drop outside every point's window and untimed landings on a 0.1 MPa chute, where
+    the rows accept a 1 ms step for most fruit.  The early bound would have refused it (found by a review): with
+    an untimed reading it is not used, and the audit runs."""
+    from pathlib import Path
+
+    from fruitimpact.spheres.audit import sphere_audit
+
+    examples = Path(__file__).parents[1] / "examples"
+    log = tmp_path / "untimed.csv"
+    log.write_text("time,peak_acceleration,velocity_change,duration\n5.000,106.4,1.646,0.00300\n"
+                   "28.924,20.0,2.023,\n29.019,6.5,0.744,\n161.290,21.0,1.964,\n161.385,6.0,0.793,\n")
+    windows = tmp_path / "windows.csv"
+    windows.write_text("name,start,end\npadded-chute,20,200\n")
+    report = sphere_audit(str(log), points=str(windows), sphere="is-1987",
+                          sphere_calibration=str(examples / "sphere-calibration.csv"), fruit="apple",
+                          sphere_restitution=0.32, method="rk4", step="1ms", rows=200, bruise_width_ratio=1.4)
+    point = next(p for p in report["points"] if p["name"] == "padded-chute")
+    assert point["incidence"] is not None

@@ -241,9 +241,10 @@ class LineAnalyzer:
         stands, but the feed prior's last fruit is again the one before it (a rebound's onset is off the feed's
         pitch, and would move the phase every later contact is judged by)."""
         onsets = self._fruit_onsets.get(lane, [])
-        if not onsets or onsets[-1][0] != sequence:
+        newest = bool(onsets) and onsets[-1][0] == sequence
+        onsets[:] = [entry for entry in onsets if entry[0] != sequence]  # never restored later either
+        if not newest:
             return  # a fruit has landed since: the last fruit is that one
-        onsets.pop()
         if onsets:
             self._last_fruit[lane] = onsets[-1][1]
         else:

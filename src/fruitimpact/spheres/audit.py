@@ -431,7 +431,8 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
     the sphere's Hertz stiffness from its duration (lengthened by ``DURATION_MARGIN`` and half a logger period) at
     the fastest landing its velocity change allows (V_in = ΔV, e → 0) bounds E*_sw from below, and E'_w ≥ E*_sw.
     The fruit lands at least at ΔV/2 (e ≤ 1) of the slowest reading, with its own modulus and ν = 0 (the softest).
-    A step that some fruit may meet is left to the rows (the exact check after the inversion)."""
+    A step that some fruit may meet is left to the rows (the exact check after the inversion), and so is every
+    step when a reading has no duration, or the lot's material is not drawn (``--no-spreads``)."""
     from fruitimpact.handling.heights import AXIS_INPUTS
     from fruitimpact.impact.lots import read_lot
     from fruitimpact.impact.solvers import RK4_MIN_STEPS_PER_CONTACT
@@ -443,7 +444,9 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
         return
     timed = np.isfinite(readings.duration) & (readings.duration > 0) & np.isfinite(readings.change) \
         & (readings.change > 0)
-    if not timed.any():
+    if not timed.all():
+        # a reading without a duration (its e from --sphere-restitution) may put a point on a surface softer, or
+        # at a speed lower, than any timed reading says: no bound (found by a review)
         return
     source, _, _ = read_lot(inputs, rows=rows, seed=seed, spreads=spreads, criterion=criterion,
                             excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
