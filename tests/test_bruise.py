@@ -525,3 +525,22 @@ def test_module_is_pure_numerics():
         elif isinstance(node, ast.ImportFrom):
             imported.add("." * node.level + (node.module or ""))
     assert imported <= {"__future__", "math", "collections.abc", "dataclasses", "numpy", "fruitimpact.physics.constants"}
+
+
+def test_a_fruit_that_absorbed_nothing_gets_no_volume_and_does_not_refuse_the_table():
+    """A threshold given on the absorbed-energy basis is carried to the susceptibility's (impact) basis by the ratio
+    of the two energies (damage.assess).  An elastic law (e = 1) absorbs nothing, the ratio is infinite, and one such
+    row made the whole table raise "threshold_energy must be a finite number" (found by a fuzz of fi.evaluate).  A
+    fruit that absorbed nothing is below any positive threshold on its own basis: bruise volume 0; the row beside it
+    keeps BS (W − W_th W/W_f) of the published form BV = BS (W − W_th)."""
+    from fruitimpact.damage.assess import CRITERION_NAMES, bruise_columns
+
+    shear = CRITERION_NAMES.index("shear")
+    out = bruise_columns(np.array([shear, shear]), peak_pressure=np.array([1e6, 1e6]), poisson=np.array([0.35, 0.35]),
+                         fruit_energy=np.array([0.0, 0.1]), volume_energy=np.array([0.2, 0.2]),
+                         failure_stress=np.array([2e5, 2e5]), threshold_energy=np.array([0.05, 0.05]),
+                         susceptibility=np.array([5e-6, 5e-6]), contact_radius=np.array([0.01, 0.01]),
+                         valid=np.array([True, True]), width_ratio=1.4)
+    assert out["bruised"].tolist() == [1.0, 1.0]
+    assert out["bruise_volume"][0] == 0.0
+    assert out["bruise_volume"][1] == pytest.approx(5e-6 * (0.2 - 0.05 * 0.2 / 0.1), rel=1e-12)

@@ -110,3 +110,16 @@ def test_batch_rows_carry_their_warnings():
     assert result.loc[0, "warnings"] == ""
     assert "mass is outside the plausible range" in result.loc[1, "warnings"]
     assert list(result["status"]) == ["ok", "ok"]
+
+
+def test_a_number_or_nan_in_a_text_column_refuses_its_row_not_the_table():
+    """A text column holding a number or a NaN (pandas' missing cell of a string column) was refused on its row by
+    the registry check, then raised TypeError while the output's categories were built (found by a fuzz of
+    fi.evaluate): a batch must never die on one bad row.  The row is invalid, named with what it holds; the others
+    are computed."""
+    import fruitimpact as fi
+
+    for column, cell in (("fruit", 1.5), ("fruit", float("nan")), ("surface", float("nan"))):
+        df = fi.evaluate({"mass": [0.1, 0.2], column: ["apple" if column == "fruit" else "steel", cell]})
+        assert df["status"].tolist() == ["ok", "invalid"], column
+        assert df["message"][1].startswith(f"{column} must be one of") and df["message"][1].endswith(f"got {cell}")

@@ -87,7 +87,11 @@ def bruise_columns(criterion: np.ndarray, *, peak_pressure, poisson, fruit_energ
         energy = volume_energy[rows_of]
         if volume_energy is not fruit_energy:  # the threshold on the susceptibility's basis
             with np.errstate(divide="ignore", invalid="ignore"):
-                threshold = np.where(threshold > 0.0, threshold * energy / fruit_energy[rows_of], 0.0)
+                carried = threshold * energy / fruit_energy[rows_of]
+            # a fruit that absorbed nothing (e = 1: an elastic law) is below any positive threshold on its own
+            # basis, which no ratio carries over (it was inf, and one such row refused the whole table): its
+            # threshold on the volume's basis is then the energy itself, so its volume is 0
+            threshold = np.where(threshold > 0.0, np.where(np.isfinite(carried), carried, energy), 0.0)
         volume = bruise.bruise_volume(energy, susceptibility[rows_of], threshold, bruised)
         ratio = np.broadcast_to(np.asarray(width_ratio, dtype=float), (rows,))[rows_of]
         depth, width = bruise.bruise_geometry(volume, contact_radius[rows_of], ratio)

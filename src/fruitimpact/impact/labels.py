@@ -60,10 +60,12 @@ class Labels:
 
 
 def _unique(labels) -> list[str]:
-    """Categories must be unique: a repeated label gets invisible padding (zero-width spaces)."""
+    """Categories must be unique: a repeated label gets invisible padding (zero-width spaces).  A label that is not
+    text (a number or NaN in a text column: its row is refused) is shown as the user wrote it, ``str`` of it."""
     seen: dict[str, int] = {}
     out = []
     for label in labels:
+        label = label if isinstance(label, str) else str(label)
         count = seen.get(label, 0)
         seen[label] = count + 1
         out.append(label + "\u200b" * count)
