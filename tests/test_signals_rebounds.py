@@ -1327,20 +1327,53 @@ def test_a_rebound_found_to_have_been_one_gives_the_feed_prior_its_last_fruit_ba
 
     pitch = 0.125
     analyzer = Analysis(RATE, fit=True, velocity=V_LINE, pitch=pitch).analyzer()
-    analyzer._last_fruit = {0: 1.0 + 0.055}
     analyzer._fruit_onsets = {0: [(4, 1.0 - pitch), (6, 1.0), (7, 1.0 + 0.055)]}  # #7: a rebound taken for a fruit
     next_fruit = summary(impact(), 1.0 + pitch, 9)
-    assert _threshold(next_fruit, analyzer._last_fruit[0], pitch)[0] == 1.25  # 0.56 pitch after #7: off the pitch
+    assert _threshold(next_fruit, analyzer._last_fruit(0), pitch)[0] == 1.25  # 0.56 pitch after #7: off the pitch
     analyzer._not_a_fruit(0, 7)
-    assert analyzer._last_fruit[0] == 1.0 and analyzer._fruit_onsets[0][-1] == (6, 1.0)
-    assert _threshold(next_fruit, analyzer._last_fruit[0], pitch)[0] == 0.8  # one pitch after #6: on it
+    assert analyzer._last_fruit(0) == 1.0 and analyzer._fruit_onsets[0][-1] == (6, 1.0)
+    assert _threshold(next_fruit, analyzer._last_fruit(0), pitch)[0] == 0.8  # one pitch after #6: on it
     analyzer._not_a_fruit(0, 4)  # not the last fruit any more: the last fruit stays, #4 is forgotten
-    assert analyzer._last_fruit[0] == 1.0 and analyzer._fruit_onsets[0] == [(6, 1.0)]
+    assert analyzer._last_fruit(0) == 1.0 and analyzer._fruit_onsets[0] == [(6, 1.0)]
     analyzer._not_a_fruit(0, 6)
-    assert 0 not in analyzer._last_fruit
+    assert analyzer._last_fruit(0) is None
     # a contact found to be a rebound while a later fruit is the last never comes back (found by a review)
-    analyzer._last_fruit = {0: 1.055}
     analyzer._fruit_onsets = {0: [(4, 1.0 - pitch), (6, 1.0), (7, 1.055)]}
     analyzer._not_a_fruit(0, 6)
     analyzer._not_a_fruit(0, 7)
-    assert analyzer._last_fruit[0] == 1.0 - pitch
+    assert analyzer._last_fruit(0) == 1.0 - pitch
+
+
+def test_the_analysis_gives_the_feed_prior_its_last_fruit_back_when_a_bounce_shows_a_rebound(monkeypatch):
+    """The wiring of the test above (a review found that removing the call left it passing): three fruit on the
+    feed's pitch, and the third contact taken for the bounce of the second (``rebound_of_a_rebound`` stubbed to say
+    so, with the evidence a real verdict carries): the lane's last fruit is then the first fruit again, the second's
+    onset forgotten; without the stub the third is the last fruit."""
+    import fruitimpact.signals.analysis as analysis_module
+    from fruitimpact.signals.rebounds import NEW_FRUIT, Verdict
+
+    pitch = 0.1
+    fruit = [impact(), impact(mass=1.05 * MASS), impact(mass=0.95 * MASS)]
+    x = _signal([0.1, 0.1 + pitch, 0.1 + 2 * pitch], fruit, int(0.45 * RATE))
+
+    def run():
+        analyzer = Analysis(RATE, fit=True, velocity=V_LINE, pitch=pitch).analyzer()
+        reports = [report for i in detect(x, RATE) for report in analyzer.reports(i)]
+        return analyzer, reports
+
+    analyzer, reports = run()
+    assert [r["rebound"] for r in reports] == [False, False, False]
+    assert analyzer._last_fruit(0) == pytest.approx(reports[2]["start_time"])
+
+    def stub(candidate, parents, lane_fruit, velocity, max_flight):
+        if candidate.sequence != 2:
+            return NEW_FRUIT
+        evidence = {"kind": "rebound_of_a_rebound", "parent": 1, "score": 0.5, "threshold": 1.0, "landing_speed": 0.3,
+                    "reason": "stubbed: the bounce of #1"}
+        return Verdict(True, 1, True, 0.5, evidence)
+
+    monkeypatch.setattr(analysis_module, "rebound_of_a_rebound", stub)
+    monkeypatch.setattr(analysis_module, "QUIET_LANE_FRUIT", 100)  # three fruit: not a quiet lane yet either way
+    analyzer, reports = run()
+    assert reports[2]["rebound"] and reports[2]["rebound_of"] == 1
+    assert analyzer._last_fruit(0) == pytest.approx(reports[0]["start_time"])

@@ -323,8 +323,9 @@ def read_columns(table, messages: MessageBook | None = None, rows: int | None = 
     given_matrix = np.zeros((len(NUMERIC_INPUTS), rows), dtype=bool)
     values, given, text = {}, {}, {}
     for j, name in enumerate(NUMERIC_INPUTS):
-        matrix[j] = np.nan
-        if name in by_key:
+        if name not in by_key:  # a given input's row is written whole below
+            matrix[j] = np.nan
+        else:
             column = by_key[name]
             plain = isinstance(column, list) and all(type(c) is float or type(c) is int for c in column)
             try:

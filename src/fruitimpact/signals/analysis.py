@@ -99,9 +99,8 @@ class LineAnalyzer:
     def __init__(self, analysis: Analysis):
         self.analysis = analysis
         self._history: dict[int, list[PulseSummary]] = {}
-        #: per lane: the onset [s] of the last contact taken for a fruit (the feed prior's phase), and the recent
-        #: ones as (sequence, onset), so that a contact found later to have been a rebound gives its place back
-        self._last_fruit: dict[int, float] = {}
+        #: per lane: (sequence, onset [s]) of the recent contacts taken for a fruit, the last one the feed prior's
+        #: phase (``_last_fruit``); a contact found later to have been a rebound gives its place back
         self._fruit_onsets: dict[int, list[tuple[int, float]]] = {}
         #: per lane: (sequence, onset [s], end [s]) of recent contacts that could not be measured (overlaps)
         self._unmeasured: dict[int, list[tuple]] = {}
@@ -241,21 +240,19 @@ class LineAnalyzer:
         stands, but the feed prior's last fruit is again the one before it (a rebound's onset is off the feed's
         pitch, and would move the phase every later contact is judged by)."""
         onsets = self._fruit_onsets.get(lane, [])
-        newest = bool(onsets) and onsets[-1][0] == sequence
-        onsets[:] = [entry for entry in onsets if entry[0] != sequence]  # never restored later either
-        if not newest:
-            return  # a fruit has landed since: the last fruit is that one
-        if onsets:
-            self._last_fruit[lane] = onsets[-1][1]
-        else:
-            self._last_fruit.pop(lane, None)
+        onsets[:] = [entry for entry in onsets if entry[0] != sequence]  # a fruit landed since stays the last
+
+    def _last_fruit(self, lane: int) -> float | None:
+        """The onset [s] of ``lane``'s last contact taken for a fruit (the feed prior's phase), None before one."""
+        onsets = self._fruit_onsets.get(lane)
+        return onsets[-1][1] if onsets else None
 
     def _rebounds(self, parts, noise: float) -> list[bool]:
         """Which pieces of a split are judged rebounds of earlier contacts of their lane, as ``_contact`` will
         judge them: ``rebounds.judge`` on each piece's own indices and fit, in time order, with the feed prior and
         the last fruit's onset (an earlier piece judged a fruit is the last fruit for the next)."""
         lane = parts[0][0].lane
-        history, last_fruit = self._history.get(lane, []), self._last_fruit.get(lane)
+        history, last_fruit = self._history.get(lane, []), self._last_fruit(lane)
         flags = []
         for piece, fit in parts:
             summary = from_indices(impact_indices(piece, self.analysis.rate), -1, noise, None)
@@ -325,7 +322,7 @@ class LineAnalyzer:
         verdict = None
         if summary is not None and analysis.flight_limit > 0:
             verdict = judge(summary, history, max_flight=analysis.flight_limit,
-                            last_fruit_onset=self._last_fruit.get(impact.lane), pitch=analysis.pitch,
+                            last_fruit_onset=self._last_fruit(impact.lane), pitch=analysis.pitch,
                             quiet_fruit=self._quiet_fruit(impact.lane))
         chosen, hidden_fruit = verdict, False
         judged = verdict is not None and (verdict.rebound or verdict.ambiguous)
@@ -421,7 +418,6 @@ class LineAnalyzer:
             recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
             history[:] = recent[-8:]
         if not rebound and status != "overlap":
-            self._last_fruit[impact.lane] = report["start_time"]
             onsets = self._fruit_onsets.setdefault(impact.lane, [])
             onsets.append((sequence, report["start_time"]))
             del onsets[:-4]

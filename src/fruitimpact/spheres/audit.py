@@ -424,8 +424,8 @@ DURATION_MARGIN = 1.5
 
 def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, period) -> None:
     """Refuse, before the inversion (the compiled pulse table, ~0.6 s), an rk4 step that every fruit of the lot
-    would be refused for at every point the log measured: the step above 1/20 of the longest Hertz contact
-    duration any fruit can have there (``solvers.max_rk4_step``'s rule).
+    would be refused for at every point the log measured: the step above ``solvers.max_rk4_step`` (1/20 of the
+    Hertz contact duration) of the longest contact any fruit can have there.
 
     The bound holds whatever the inversion finds.  Each reading's surface is at least as stiff as the sphere saw it:
     the sphere's Hertz stiffness from its duration (lengthened by ``DURATION_MARGIN`` and half a logger period) at
@@ -434,13 +434,13 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
     A step that some fruit may meet is left to the rows (the exact check after the inversion), and so is every
     step when a reading has no duration, or the lot's material is not drawn (``--no-spreads``)."""
     from fruitimpact.handling.heights import AXIS_INPUTS
+    from fruitimpact.impact.labels import Labels
     from fruitimpact.impact.lots import read_lot
-    from fruitimpact.impact.solvers import RK4_MIN_STEPS_PER_CONTACT
+    from fruitimpact.impact.solvers import RK4_MIN_STEPS_PER_CONTACT, RK4_STEP_REFUSAL, max_rk4_step
     from fruitimpact.impact.validation import InputError
     from fruitimpact.physics.hertz import effective_modulus, hertz_contact_duration, hertz_stiffness
 
-    if inputs.get("step") is None or str(inputs.get("method", "")).strip().lower() != "rk4" \
-            or inputs.get("stiffness") is not None:
+    if inputs.get("step") is None or inputs.get("stiffness") is not None:
         return
     timed = np.isfinite(readings.duration) & (readings.duration > 0) & np.isfinite(readings.change) \
         & (readings.change > 0)
@@ -452,22 +452,21 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
                             excluded=("velocity", "drop_height", *AXIS_INPUTS["surface"]),
                             excluded_reason="is set by each transfer point the sphere measured")
     columns = source.inputs(0, rows, None)[0]
-    if not all(isinstance(columns.get(name), np.ndarray) for name in ("step", "mass", "diameter", "modulus")):
+    method = columns.get("method")
+    if not (isinstance(method, Labels) and set(method.labels) == {"rk4"}) \
+            or not all(isinstance(columns.get(name), np.ndarray) for name in ("step", "mass", "diameter", "modulus")):
         return
-    longest = (readings.duration[timed] + period / 2.0) * DURATION_MARGIN
-    change = readings.change[timed]
+    longest = (readings.duration + period / 2.0) * DURATION_MARGIN
     # T ∝ K^(-2/5) at given m and v: the stiffness whose Hertz duration is the longest reading, at V_in = ΔV
-    sphere_stiffness = (hertz_contact_duration(body.mass, 1.0, change) / longest) ** 2.5
+    sphere_stiffness = (hertz_contact_duration(body.mass, 1.0, readings.change) / longest) ** 2.5
     surface = float(np.min(sphere_stiffness / hertz_stiffness(1.0, body.diameter / 2.0)))  # E*_sw [Pa]
-    fruit_modulus = effective_modulus(columns["modulus"], 0.0, surface, 0.0)
-    duration = hertz_contact_duration(columns["mass"], hertz_stiffness(fruit_modulus, columns["diameter"] / 2.0),
-                                      float(np.min(change)) / 2.0)
-    bound = duration / RK4_MIN_STEPS_PER_CONTACT
+    fruit_stiffness = hertz_stiffness(effective_modulus(columns["modulus"], 0.0, surface, 0.0),
+                                      columns["diameter"] / 2.0)
+    bound = max_rk4_step(columns["mass"], fruit_stiffness, float(np.min(readings.change)) / 2.0)
     step = columns["step"]
     if np.all(step > bound):
-        raise InputError(f"step must be at most 1/20 of the contact duration for rk4 (at least "
-                         f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact); got {float(np.max(step)):.6g} s, and no "
-                         f"fruit of the lot has a contact longer than {float(np.max(duration)) * 1e3:.3g} ms at the "
+        raise InputError(f"{RK4_STEP_REFUSAL}; got {float(np.max(step)):.6g} s, and no fruit of the lot has a "
+                         f"contact longer than {float(np.max(bound)) * RK4_MIN_STEPS_PER_CONTACT * 1e3:.3g} ms at the "
                          f"points this log measured (at most {float(np.max(bound)):.3g} s)", "step")
 
 
