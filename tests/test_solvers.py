@@ -157,3 +157,25 @@ def test_peak_force_rises_with_velocity_and_stiffness(fruit, velocity, factor, d
     # α → k = 1 - α V → λ loses digits as α V → 0 (1 - (1 - αV)); 1e-9 is ample here
     assert stiffer.law.damping == pytest.approx(lam, rel=1e-9, abs=1e-12 * k_c)
     assert stiffer.characteristics.peak_force > base.characteristics.peak_force
+
+
+def test_an_rk4_step_too_fine_to_end_the_contact_is_refused_before_any_work():
+    """rk4 runs at most RK4_MAX_STEPS steps per impact, and no contact here is shorter than the undamped Hertz
+    duration T_H = 2.9432 δ*/V with δ* = (5 m V²/(4 K))^(2/5) (Johnson 1985, §11.4; damping lengthens it): a step below T_H/RK4_MAX_STEPS
+    cannot end the contact.  Such a step (1e-30 s, found by an attack) ran every row to the limit and failed each,
+    and advised "a step of at most 1e-31 s"; a lot or a sphere audit of 10,000 fruit ran for minutes.  It is
+    refused like a step too coarse, with the range the impact allows; a step just inside the range computes."""
+    import re
+
+    import fruitimpact as fi
+    from fruitimpact.impact.solvers import RK4_MAX_STEPS
+
+    mass, stiffness, velocity = 0.115, 8.3549e5, 1.0  # the paper's Jonathan apple at 1 m/s (its k_c)
+    hertz = 2.9432 * (5.0 * mass * velocity ** 2 / (4.0 * stiffness)) ** 0.4 / velocity
+    finest = hertz / RK4_MAX_STEPS
+    with pytest.raises(ValueError, match=r"step must be in \[") as refused:
+        fi.simulate(method="rk4", step=0.9 * finest)
+    low = float(re.search(r"in \[([0-9.e+-]+),", str(refused.value)).group(1))
+    assert low == pytest.approx(finest, rel=2e-3)  # printed to 3 digits
+    result = fi.simulate(method="rk4", step=max(20 * finest, 1e-8))
+    assert result.status == "ok" and result.characteristics.restitution == pytest.approx(0.577, rel=1e-3)

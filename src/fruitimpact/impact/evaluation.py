@@ -37,8 +37,8 @@ from fruitimpact.damage.assess import CRITERION_NAMES, bruise_columns
 from fruitimpact.engine.plasticforms import PLASTIC_COLUMNS, winkler_stiffness, yield_pressure_of_force
 from fruitimpact.impact.quantities import (ALLOWED_BOUNDS, ALTERNATIVES, DAMAGE_NAMES, GROUP_DEFAULTS, INPUTS, NUMERIC_DEFAULTS,
                          NUMERIC_INPUTS, PLAUSIBLE_BOUNDS, TEXT_INPUTS, inside)
-from fruitimpact.impact.solvers import (RK4_MIN_STEPS_PER_CONTACT, RK4_STEP_REFUSAL, SOLVERS, max_rk4_step,
-                                        power_law_closed_forms)
+from fruitimpact.impact.solvers import (RK4_FINE_STEP_REFUSAL, RK4_MAX_STEPS, RK4_MIN_STEPS_PER_CONTACT,
+                                        RK4_STEP_REFUSAL, SOLVERS, max_rk4_step, power_law_closed_forms)
 from fruitimpact.impact.status import FAILED, INVALID, STATUS_NAMES, UNDERFLOW_MESSAGE, judge
 from fruitimpact.impact.labels import Labels
 from fruitimpact.impact import fruitfiles
@@ -320,6 +320,14 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                 text = (f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
                         f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact); got {float(step[0])!r}")
             messages.set(too_coarse, text, "step")
+        finest = limit * RK4_MIN_STEPS_PER_CONTACT / RK4_MAX_STEPS
+        too_fine = rk4 & ~messages.flagged & (step < finest)
+        if too_fine.any():
+            text = RK4_FINE_STEP_REFUSAL
+            if detail:
+                text = (f"step must be in [{float(finest[0]):.3g}, {float(limit[0]):.3g}] s for this impact (at most "
+                        f"{RK4_MAX_STEPS:,} steps per contact); got {float(step[0])!r}")
+            messages.set(too_fine, text, "step")
 
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)

@@ -25,6 +25,10 @@ from fruitimpact.engine.codes import N_CHARACTERISTICS
 RK4_MAX_STEPS = 2_000_000
 #: Fewest RK4 steps per contact accepted (the step may be at most T_Hertz / this).
 RK4_MIN_STEPS_PER_CONTACT = 20
+#: The refusal of a step finer than ``RK4_MAX_STEPS`` steps over the undamped Hertz duration, a lower bound of T:
+#: such a contact cannot end within the steps allowed (it ran every row to the limit, and failed each).
+RK4_FINE_STEP_REFUSAL = (f"step must be at least 1/{RK4_MAX_STEPS:,} of the contact duration for rk4 (at most "
+                         f"{RK4_MAX_STEPS:,} steps per contact)")
 #: The refusal of a step coarser than ``max_rk4_step`` (a row's message; a run refused whole starts with it).
 RK4_STEP_REFUSAL = (f"step must be at most 1/{RK4_MIN_STEPS_PER_CONTACT} of the contact duration for rk4 (at least "
                     f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact)")
@@ -217,4 +221,5 @@ def get_solver(name: str) -> Solver:
 
 
 __all__ = ["ADAPTIVE_RTOL", "RK4_MAX_STEPS", "RK4_MIN_STEPS_PER_CONTACT", "SOLVERS", "Solver", "power_law_closed_forms",
-           "get_solver", "max_rk4_step", "RK4_MIN_STEPS_PER_CONTACT", "RK4_STEP_REFUSAL"]
+           "get_solver", "max_rk4_step", "RK4_MIN_STEPS_PER_CONTACT", "RK4_STEP_REFUSAL",
+           "RK4_FINE_STEP_REFUSAL"]
