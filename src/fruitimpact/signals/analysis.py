@@ -42,7 +42,7 @@ from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
                                          Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
                                          judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         landing_speed, rebound_of_a_rebound, rebounds_due,
+                                         landing_speed, rebound_of_a_rebound, rebound_pulse, rebounds_due,
                                          rebounds_landed_together, refine, shape_table, too_light_for_fruit,
                                          unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
@@ -377,7 +377,8 @@ class LineAnalyzer:
         if orphan is not None:
             speed = None  # its speed is not measured: the fit leaves m and K unsplit
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
-            self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
+            if not chosen.evidence.get("new_fruit_excluded"):  # else a rebound of it or of another unseen contact
+                self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
             landing = landing_speed(chosen.evidence["flight_observed"])
         elif rebound and slow_parent:  # its parent was a rebound taken for a fruit: no longer one of the lane's fruit
@@ -387,9 +388,11 @@ class LineAnalyzer:
             speed = None  # the parent's speed is read from this flight, not measured: the fit leaves m and K unsplit
             landing = chosen.evidence["landing_speed"]
         elif rebound and chosen is not None:
+            if chosen.reassigned is not None:  # the parent's earlier claimant is re-read as another's rebound
+                self._reassign(history, chosen)
             index = claimed_parent(summary, history, chosen.parent)
             parent = history[index]
-            history[index] = parent.taken()
+            history[index] = parent.taken(by=sequence)
             self._read_speed(impact.lane, summary, parent, chosen)
             # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
             speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
@@ -412,8 +415,18 @@ class LineAnalyzer:
         if summary is not None:
             # a hidden fruit's rebound: its flight from the overlap fixes the speed it landed at, so its own bounce
             # can be expected (``rebounds_due``) and its flight tested; the fit still leaves its m and K unsplit
-            history.append(summary.with_velocity(landing, False) if speed is None and _finite(landing)
-                           else summary.with_velocity(speed, read))
+            kept = summary.with_velocity(landing, False) if speed is None and _finite(landing) \
+                else summary.with_velocity(speed, read)
+            if not rebound and status == "ok" and orphan is None and due:
+                # a new fruit while a rebound was due in it: that rebound may have landed with it, too close to
+                # tell apart, and then the fruit's own rebound is judged against the fruit alone as well
+                # (``rebounds.held_alternative``)
+                held = likeliest_hidden(list(due), report["start_time"])
+                if held is not None:
+                    impulse = rebound_pulse(held)[0]
+                    kept = dataclasses.replace(kept, held=(impulse, math.exp(expected_rebound(held)["log_peak"]),
+                                                           held.sequence))
+            history.append(kept)
             # keep the contacts a later one could still be the rebound of
             recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
             history[:] = recent[-8:]
@@ -462,6 +475,21 @@ class LineAnalyzer:
         report["status"] = status
         report["message"] = message
         return report
+
+    @staticmethod
+    def _reassign(history: list[PulseSummary], verdict: Verdict) -> None:
+        """Re-read the contact that had claimed ``verdict``'s parent as the rebound of the parent the pairing gave
+        it (``rebounds.reassigned``): that parent is marked taken by it, and its impact speed is the new parent's
+        r V (as for any rebound; None when that parent's speed is a guess), so its own bounce is expected from
+        there.  ``verdict``'s parent stays taken, now by the contact being judged (the caller)."""
+        claimant, parent = verdict.reassigned
+        mine = next(i for i, s in enumerate(history) if s.sequence == claimant and not s.virtual)
+        index = claimed_parent(history[mine], history, parent)
+        new_parent = history[index]
+        history[index] = new_parent.taken(by=claimant)
+        ratio = verdict.evidence["reassigned"]["speed_ratio"]
+        speed = ratio * new_parent.velocity if new_parent.velocity is not None and not new_parent.virtual else None
+        history[mine] = history[mine].with_velocity(speed, new_parent.speed_read)
 
     def _quiet_fruit(self, lane: int) -> int:
         """How many fruit ``lane`` has reported without a single rebound (0 once it has shown one): a lane that

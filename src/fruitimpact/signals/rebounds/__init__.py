@@ -59,7 +59,8 @@ from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLE
                                                rebounds_landed_together, too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
                                                    QUIET_LANE_FRUIT, claimed_parent, expected_rebound,
-                                                   hidden_rebound, judge, likeliest_hidden, rebounds_due)
+                                                   hidden_rebound, judge, likeliest_hidden, rebound_pulse,
+                                                   rebounds_due)
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
                                                  flight_time, from_indices, landing_speed, refine, shape_table)
 
@@ -70,5 +71,5 @@ __all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RA
            "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",
            "flight_time", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
            "landing_speed", "likeliest_hidden",
-           "rebound_of_a_rebound", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
+           "rebound_of_a_rebound", "rebound_pulse", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
            "too_light_for_fruit", "unmeasured_fruit"]

@@ -5,7 +5,7 @@ of them (``judge``), whose rebound is due when (``rebounds_due``), and what puls
 from __future__ import annotations
 
 import math
-
+from dataclasses import replace
 
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at,
                                                  flight_time)
@@ -94,6 +94,12 @@ def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: f
     parents = [p for p in reversed(earlier) if not p.rebound_taken and p.onset < candidate.onset
                and candidate.onset - p.separation <= max_flight]
     best = min((_hypothesis(candidate, p) for p in parents), key=lambda ev: ev["score"], default=None)
+    if best is None or not best["score"] <= threshold:
+        other = reassigned(candidate, earlier, threshold, max_flight) \
+            or held_alternative(candidate, parents, threshold)
+        if other is not None:
+            other.evidence["feed_prior"] = prior
+            return other
     if best is None:
         return NEW_FRUIT
     score = best["score"]
@@ -106,6 +112,98 @@ def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: f
         return NEW_FRUIT
     return Verdict(rebound, best["parent"] if rebound else None, ambiguous,
                    best["speed_ratio"] if rebound else None, best)
+
+
+def reassigned(candidate: PulseSummary, earlier: list[PulseSummary], threshold: float,
+               max_flight: float) -> Verdict | None:
+    """``candidate`` as the rebound of a contact P whose rebound was already claimed by a contact C, when C is as
+    well the rebound of another contact Q still free: a fruit's rebound and the bounce of an earlier rebound can
+    land within a few ms of each other, and C, judged first, took the better-scoring of the two parents it fitted.
+    Each contact rebounds once, so the pairing must explain both: candidate → P and C → Q, each within
+    ``threshold`` (the same tests, ``_hypothesis``); of several, the one whose worse score is least.  Without
+    such a pairing the candidate was judged against the free parents alone (``judge``); with it, it is P's
+    rebound and C is re-read as Q's (its own line, already written, keeps the parent it was judged with: a
+    rebound is not graded either way).  Only parents claimed through ``judge`` are re-read (``taken_by``)."""
+    by_sequence = {p.sequence: p for p in earlier if not p.virtual}
+    options = []
+    for taken in earlier:
+        claimant = by_sequence.get(taken.taken_by) if taken.rebound_taken and taken.taken_by is not None else None
+        if claimant is None or not taken.onset < candidate.onset or candidate.onset - taken.separation > max_flight:
+            continue
+        mine = _hypothesis(candidate, taken)
+        if not mine["score"] <= threshold:
+            continue
+        for other in earlier:
+            if other is taken or other is claimant or other.rebound_taken or not other.onset < claimant.onset \
+                    or claimant.onset - other.separation > max_flight:
+                continue
+            theirs = _hypothesis(claimant, other)
+            if theirs["score"] <= threshold:
+                options.append((max(mine["score"], theirs["score"]), mine, theirs, claimant))
+    if not options:
+        return None
+    worst, mine, theirs, claimant = min(options, key=lambda option: option[0])
+    mine["threshold"] = threshold
+    mine["score"] = round(mine["score"], 3)
+    mine["reassigned"] = {"contact": claimant.sequence, "was_rebound_of": mine["parent"],
+                          "rebound_of": theirs["parent"], "score": round(theirs["score"], 3),
+                          "speed_ratio": theirs["speed_ratio"],
+                          "deviations": theirs["deviations"]}
+    ambiguous = AMBIGUOUS[0] * threshold < worst
+    return Verdict(True, mine["parent"], ambiguous, mine["speed_ratio"], mine,
+                   reassigned=(claimant.sequence, theirs["parent"]))
+
+
+#: The least share of a contact's impulse a fruit must keep once a rebound held in it is taken out
+#: (``held_alternative``): below it the contact was mostly that rebound, not a fruit with one.
+HELD_FRUIT_SHARE = 0.4
+
+
+def without_held(parent: PulseSummary) -> PulseSummary | None:
+    """``parent``, a contact judged a new fruit while a rebound was due in it (``PulseSummary.held``), as the fruit
+    alone: the held rebound's predicted impulse and peak (``hidden_rebound``) taken out.  Two pulses landing within
+    a fraction of a millisecond add their impulses and, nearly, their peaks; the fruit's time to peak and shape
+    are kept.  The sds grow by the prediction's own (``EXPECTED_RATIO_SD`` of r, which the impulse and peak follow
+    to the first and 1.2th power).  None when the fruit would keep less than ``HELD_FRUIT_SHARE`` of the impulse."""
+    if parent.held is None:
+        return None
+    impulse, peak, _ = parent.held
+    fruit_impulse, fruit_peak = parent.impulse - impulse, parent.peak_force - peak
+    if not (fruit_impulse >= HELD_FRUIT_SHARE * parent.impulse and fruit_peak > 0):
+        return None
+    impulse_sd = math.hypot(parent.impulse_sd * parent.impulse, EXPECTED_RATIO_SD * impulse) / fruit_impulse
+    peak_sd = math.hypot(parent.peak_force_sd * parent.peak_force, 1.2 * EXPECTED_RATIO_SD * peak) / fruit_peak
+    return replace(parent, impulse=fruit_impulse, peak_force=fruit_peak, impulse_sd=impulse_sd, peak_force_sd=peak_sd,
+                   held=None)
+
+
+def held_alternative(candidate: PulseSummary, parents: list[PulseSummary], threshold: float) -> Verdict | None:
+    """``candidate`` as the rebound of a fruit that landed together with a rebound due in its contact, within a
+    fraction of a millisecond (one pulse to a joint fit too, so the contact was read as one fruit, its impulse
+    and peak those of both).  The fruit's own rebound then fails the tests against the contact as measured (its
+    speed ratio, read from the impulses, comes out too low by the held share) but passes them against the fruit
+    alone (``without_held``).  The physics bounds it as for any parent: r cannot exceed the fruit's e by more
+    than the tolerance, so a lone fruit (whose due rebound landed elsewhere) is not claimed through this.  The
+    verdict is said to be ambiguous; its evidence names the rebound held.  None when no such parent passes."""
+    options = []
+    for parent in parents:
+        alone = without_held(parent) if not parent.virtual else None
+        if alone is not None:
+            evidence = _hypothesis(candidate, alone)
+            if evidence["score"] <= threshold:
+                options.append(evidence)
+    if not options:
+        return None
+    best = min(options, key=lambda ev: ev["score"])
+    parent = next(p for p in parents if p.sequence == best["parent"] and p.held is not None)
+    impulse, peak, held_parent = parent.held
+    best["threshold"] = threshold
+    best["score"] = round(best["score"], 3)
+    best["held_rebound"] = {"rebound_of": held_parent, "impulse": impulse, "peak_force": peak,
+                            "reason": f"contact #{parent.sequence} was read as one fruit while the rebound of "
+                                      f"#{held_parent} was due in it and not seen elsewhere: judged as that "
+                                      f"fruit alone"}
+    return Verdict(True, best["parent"], True, best["speed_ratio"], best)
 
 
 def claimed_parent(candidate: PulseSummary, earlier: list[PulseSummary], sequence: int) -> int:
@@ -197,7 +295,7 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
     guess = expected_rebound(parent)
     r = EXPECTED_RATIO * parent.restitution
     xr = guess["x"]
-    impulse, e_r, _ = _rebound_pulse(parent)
+    impulse, e_r, _ = rebound_pulse(parent)
     de_dx = (_at("e", xr * 1.05) - _at("e", xr / 1.05)) / (xr * (1.05 - 1.0 / 1.05)) if xr > 0 else 0.0
     tc = parent.time_to_peak * r ** -0.2 * _at("tc", xr) / _at("tc", parent.x)
     return PulseSummary(sequence=sequence, onset=onset, separation=onset + math.exp(guess["log_duration"]),
@@ -213,7 +311,7 @@ def hidden_rebound(parent: PulseSummary, sequence: int, onset: float) -> PulseSu
 LOT_RESTITUTION_SD = 0.02
 
 
-def _rebound_pulse(parent: PulseSummary) -> tuple[float, float, float]:
+def rebound_pulse(parent: PulseSummary) -> tuple[float, float, float]:
     """(impulse [N s], restitution, its sd) of ``parent``'s rebound: the same fruit at r V_p, r =
     ``EXPECTED_RATIO`` e_p ± ``EXPECTED_RATIO_SD`` (as ``hidden_rebound``)."""
     r = EXPECTED_RATIO * parent.restitution

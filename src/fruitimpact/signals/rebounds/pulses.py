@@ -124,13 +124,21 @@ class PulseSummary:
     #: predicts when a rebound is due, but a rebound's flight is not tested against it (a wrong reading would
     #: reject the very rebounds whose flights correct it)
     speed_read: bool = False
+    #: the sequence of the contact judged its rebound (``judge``), which a later contact may show to have been the
+    #: rebound of another (``measured.reassigned``)
+    taken_by: int | None = None
+    #: (impulse [N s], peak force [N], sequence of its parent) of a rebound that was due while this contact, judged
+    #: a new fruit, lasted, and was not seen: it may have landed with it, too close for a joint fit to tell apart
+    #: (``measured.held_alternative``)
+    held: tuple[float, float, int] | None = None
 
     def with_velocity(self, velocity: float | None, read: bool = False) -> PulseSummary:
         return replace(self, velocity=velocity, speed_read=bool(read and velocity is not None))
 
-    def taken(self) -> PulseSummary:
-        """The same contact, marked as already having its rebound (a contact rebounds once)."""
-        return replace(self, rebound_taken=True)
+    def taken(self, by: int | None = None) -> PulseSummary:
+        """The same contact, marked as already having its rebound (a contact rebounds once), by contact ``by``
+        (its sequence) when that was judged against this one's pulse."""
+        return replace(self, rebound_taken=True, taken_by=by)
 
 
 def _finite(*values) -> bool:
@@ -187,6 +195,9 @@ class Verdict:
     ambiguous: bool
     speed_ratio: float | None
     evidence: dict | None
+    #: (contact, its parent now) when this rebound's parent had been claimed by ``contact``, which is re-read as
+    #: the rebound of another (``measured.reassigned``)
+    reassigned: tuple[int, int] | None = None
 
 
 NEW_FRUIT = Verdict(False, None, False, None, None)
