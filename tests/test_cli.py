@@ -775,7 +775,9 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
     (["population", "-n", "100", "--method", "rk4", "--step", "1s"], "every one of the lot's 100 fruit"),
     # a step no fruit can take at the points of a sphere's log (0.9 s: the calibration's fit and the inversion)
     (["sphere", "LOG", "--sphere", "is-1987", "--sphere-calibration", "CAL", "--fruit", "apple", "--method", "rk4",
-      "--step", "1s"], "argument --step: step must be at most 1/20 of the contact duration for rk4")])
+      "--step", "1s"], "argument --step: step must be at most 1/20 of the contact duration for rk4"),
+    (["sphere", "LOG", "--sphere", "is-1987", "--sphere-calibration", "CAL", "--fruit", "apple", "--method", "rk4",
+      "--step", "1s", "--no-spreads"], "argument --step: step must be at most 1/20 of the contact duration for rk4")])
 def test_a_usage_error_about_a_file_or_a_lot_loads_neither_numba_nor_pandas(argv, line, tmp_path):
     """Issue 15 item 4 (≤ 0.25 s): pandas alone takes 0.3 s to import; these refusals need neither it nor numba."""
     imported = _refusal_imports(argv, line, tmp_path)

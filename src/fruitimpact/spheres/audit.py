@@ -431,11 +431,16 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
     the sphere's Hertz stiffness from its duration (lengthened by ``DURATION_MARGIN`` and half a logger period) at
     the fastest landing its velocity change allows (V_in = ΔV, e → 0) bounds E*_sw from below, and E'_w ≥ E*_sw.
     The fruit lands at least at ΔV/2 (e ≤ 1) of the slowest reading, with its own modulus and ν = 0 (the softest).
-    A step that some fruit may meet is left to the rows (the exact check after the inversion), and so is every
-    step when a reading has no duration, or the lot's material is not drawn (``--no-spreads``)."""
+    The fruit's mass, diameter and modulus are those the rows will use: drawn, given, or the fruit's library
+    entry (``presets.resolve``, as ``evaluate`` reads them; ``--no-spreads`` draws none).  A step that some fruit
+    may meet is left to the rows (the exact check after the inversion), and so is every step when a reading has
+    no duration."""
     from fruitimpact.handling.heights import AXIS_INPUTS
+    from fruitimpact.impact import presets
+    from fruitimpact.impact.inputs import read_columns
     from fruitimpact.impact.labels import Labels
     from fruitimpact.impact.lots import read_lot
+    from fruitimpact.impact.quantities import INPUTS
     from fruitimpact.impact.solvers import RK4_MIN_STEPS_PER_CONTACT, RK4_STEP_REFUSAL, max_rk4_step
     from fruitimpact.impact.validation import InputError
     from fruitimpact.physics.hertz import effective_modulus, hertz_contact_duration, hertz_stiffness
@@ -454,8 +459,19 @@ def _refuse_coarse_step(inputs, rows, seed, spreads, criterion, body, readings, 
     columns = source.inputs(0, rows, None)[0]
     method = columns.get("method")
     if not (isinstance(method, Labels) and set(method.labels) == {"rk4"}) \
-            or not all(isinstance(columns.get(name), np.ndarray) for name in ("step", "mass", "diameter", "modulus")):
+            or not isinstance(columns.get("step"), np.ndarray):
         return
+    lot, _ = read_columns(columns, rows=rows)
+    defaults = presets.resolve(lot, math.nan).defaults
+
+    def used(name):  # given (or drawn) where given, else the fruit's library value or the quantity's default
+        default = INPUTS[name].default
+        return np.where(lot.given[name], lot.values[name],
+                        defaults.get(name, math.nan if default is None else default)).astype(float)
+
+    columns = {name: used(name) for name in ("mass", "diameter", "modulus")} | {"step": columns["step"]}
+    if not all(np.all(np.isfinite(value) & (value > 0)) for value in columns.values()):
+        return  # refused by the rows' own validation, with its own message
     longest = (readings.duration + period / 2.0) * DURATION_MARGIN
     # T ∝ K^(-2/5) at given m and v: the stiffness whose Hertz duration is the longest reading, at V_in = ΔV
     sphere_stiffness = (hertz_contact_duration(body.mass, 1.0, readings.change) / longest) ** 2.5
