@@ -380,10 +380,12 @@ def test_a_rebound_whose_parent_was_misread_is_still_a_rebound(cli, tmp_path, na
       median that stands for it (score 1.42, beyond the ambiguous band), but no new fruit of the lane could have
       made that pulse (14.7 sd away; ``rebounds.judge_unmeasured``);
     * chain10, seed 7, 2.495 s: its fruit was hidden in an overlap of three pulses, and the bounce of a rebound
-      hidden beside it (2.457 s) is judged the hidden fruit's rebound by the same rule; such a verdict leaves the
-      hidden fruit's own rebound free to come (``analysis``), and this is it.
+      hidden beside it (2.457 s) is judged a rebound by the same rule, its parent unnamed; such a verdict leaves the
+      hidden fruit's slot open (``analysis``), and this is the hidden fruit's own rebound.  (This one was right
+      before the rule too: it guards the open slot; a first version of the rule took it.)
 
-    Each is now a rebound, and the recording's scorecard takes no fruit for a rebound."""
+    Each is a rebound (the first three were graded as fruit before), and the recording's scorecard takes no fruit
+    for a rebound."""
     scenario = dataclasses.replace(lg.SCENARIOS[name], seed=seed)
     path, truth = lg.write(scenario, tmp_path)
     status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))

@@ -42,7 +42,7 @@ from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
                                          Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
                                          judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         landing_speed, rebound_of_a_rebound, rebound_pulse, rebounds_due,
+                                         landing_speed, rebound_of_a_rebound, rebounds_due,
                                          rebounds_landed_together, refine, shape_table, too_light_for_fruit,
                                          unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
@@ -112,6 +112,9 @@ class LineAnalyzer:
         self._quiet: dict[int, int | None] = {}
         #: per lane: the impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
         self._speeds: dict[int, list[float]] = {}
+        #: (lane, sequence) of the overlaps whose hidden fruit's slot one contact has claimed without naming it its
+        #: parent (``rebounds.judge_unmeasured``, ``new_fruit_excluded``): the next claim closes it
+        self._claimed_once: set[tuple[int, int]] = set()
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
@@ -377,7 +380,11 @@ class LineAnalyzer:
         if orphan is not None:
             speed = None  # its speed is not measured: the fit leaves m and K unsplit
         elif rebound and hidden_fruit:  # a hidden fruit rebounds once
-            if not chosen.evidence.get("new_fruit_excluded"):  # else a rebound of it or of another unseen contact
+            # a rebound of it or of another unseen contact (``new_fruit_excluded``) leaves its slot open, once
+            key = (impact.lane, chosen.parent)
+            if chosen.evidence.get("new_fruit_excluded") and key not in self._claimed_once:
+                self._claimed_once.add(key)
+            else:
                 self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
             landing = landing_speed(chosen.evidence["flight_observed"])
@@ -389,16 +396,18 @@ class LineAnalyzer:
             landing = chosen.evidence["landing_speed"]
         elif rebound and chosen is not None:
             if chosen.reassigned is not None:  # the parent's earlier claimant is re-read as another's rebound
-                self._reassign(history, chosen)
-            index = claimed_parent(summary, history, chosen.parent)
+                index = self._reassign(history, chosen)
+            else:
+                index = claimed_parent(summary, history, chosen.parent)
             parent = history[index]
             history[index] = parent.taken(by=sequence)
+            if chosen.evidence.get("held_rebound") is not None:  # the rebound held in the parent's contact was seen
+                self._held_seen(history, chosen.evidence["held_rebound"]["rebound_of"])
             self._read_speed(impact.lane, summary, parent, chosen)
-            # a rebound of a predicted (hidden) rebound: its speed is a guess, so the fit leaves m and K unsplit
-            speed = chosen.speed_ratio * parent.velocity if parent.velocity is not None and not parent.virtual \
-                else None
+            speed = _rebound_speed(chosen.speed_ratio, parent)
             read = parent.speed_read
-        report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound else
+        unnamed = hidden_fruit and chosen.evidence.get("new_fruit_excluded")  # its parent is not known
+        report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound and not unnamed else
                       pair["parents"][0] if pair is not None else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None),
                       rebound_evidence=chosen.evidence if chosen is not None else together or pair or orphan)
@@ -423,9 +432,8 @@ class LineAnalyzer:
                 # (``rebounds.held_alternative``)
                 held = likeliest_hidden(list(due), report["start_time"])
                 if held is not None:
-                    impulse = rebound_pulse(held)[0]
-                    kept = dataclasses.replace(kept, held=(impulse, math.exp(expected_rebound(held)["log_peak"]),
-                                                           held.sequence))
+                    pulse = hidden_rebound(held, sequence, report["start_time"])
+                    kept = dataclasses.replace(kept, held=(pulse.impulse, pulse.peak_force, held.sequence))
             history.append(kept)
             # keep the contacts a later one could still be the rebound of
             recent = [s for s in history if summary.onset - s.separation <= analysis.flight_limit]
@@ -477,19 +485,29 @@ class LineAnalyzer:
         return report
 
     @staticmethod
-    def _reassign(history: list[PulseSummary], verdict: Verdict) -> None:
+    def _reassign(history: list[PulseSummary], verdict: Verdict) -> int:
         """Re-read the contact that had claimed ``verdict``'s parent as the rebound of the parent the pairing gave
         it (``rebounds.reassigned``): that parent is marked taken by it, and its impact speed is the new parent's
-        r V (as for any rebound; None when that parent's speed is a guess), so its own bounce is expected from
-        there.  ``verdict``'s parent stays taken, now by the contact being judged (the caller)."""
+        r V (as for any rebound), so its own bounce is expected from there.  Returns the index of ``verdict``'s
+        parent: the entry that contact had taken (two rebounds hidden in one overlap share its sequence), which
+        the caller marks taken by the contact being judged."""
         claimant, parent = verdict.reassigned
         mine = next(i for i, s in enumerate(history) if s.sequence == claimant and not s.virtual)
+        old = next(i for i, s in enumerate(history) if s.sequence == verdict.parent and s.taken_by == claimant)
         index = claimed_parent(history[mine], history, parent)
         new_parent = history[index]
         history[index] = new_parent.taken(by=claimant)
-        ratio = verdict.evidence["reassigned"]["speed_ratio"]
-        speed = ratio * new_parent.velocity if new_parent.velocity is not None and not new_parent.virtual else None
-        history[mine] = history[mine].with_velocity(speed, new_parent.speed_read)
+        history[mine] = history[mine].with_velocity(
+            _rebound_speed(verdict.evidence["reassigned"]["speed_ratio"], new_parent), new_parent.speed_read)
+        return old
+
+    @staticmethod
+    def _held_seen(history: list[PulseSummary], sequence: int) -> None:
+        """Mark taken the contact whose rebound was held in a contact read as one fruit (``rebounds.held_alternative``
+        judged a later contact that fruit's rebound): its rebound has been seen there."""
+        index = next((i for i, s in enumerate(history) if s.sequence == sequence and not s.rebound_taken), None)
+        if index is not None:
+            history[index] = history[index].taken()
 
     def _quiet_fruit(self, lane: int) -> int:
         """How many fruit ``lane`` has reported without a single rebound (0 once it has shown one): a lane that
@@ -568,6 +586,12 @@ class LineAnalyzer:
 #: the same for every rate, and its cost grows with the rate (13 s at 10 MHz), so it runs once, at this rate.
 WARM_RATE = 20_000.0
 _WARM: list = []
+
+
+def _rebound_speed(ratio: float, parent: PulseSummary) -> float | None:
+    """The impact speed [m/s] of a rebound at speed ratio ``ratio`` of ``parent``: r V_p; None when the parent's
+    speed is unknown or a guess (a predicted hidden rebound's), so that the fit leaves m and K unsplit."""
+    return ratio * parent.velocity if parent.velocity is not None and not parent.virtual else None
 
 
 def _warm_up(analysis: Analysis) -> None:

@@ -47,25 +47,33 @@ for e ≈ 0.35–0.5 (its uncertainty is propagated).  So where a shape fit of t
 simulator's pulse fitted to its own samples, e ± 0.01 at 1 % noise; ``analysis`` fits every contact,
 with or without ``--fit``) its x, e and separation time replace the raw ones (``refine``).
 
+A rebound is judged when it lands, against the contacts still free; where that fails, two second readings
+(``measured``): the pairing that explains it and the contact that had claimed its parent, each by the tests above
+(``reassigned``: each contact rebounds once), and its parent read as a fruit alone where a due rebound may have
+landed with it too closely to tell apart (``held_alternative``).
+
 The package, one module per job: ``pulses`` (what the tests know of a contact, the force law's tables, the
 verdict), ``measured`` (a contact against earlier measured or predicted contacts), ``lane`` (a contact against the
 lane's measured fruit, standing for a fruit that was not measured).
 """
 
-from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN,
-                                               LOT_IMPULSE_SD, LOT_STIFFNESS_SD, ORPHAN_MARGIN, PAIR_DISTANCE_MAX,
-                                               PAIR_MARGIN, SLOW_PARENT_RATIO, LaneFruit, judge_unmeasured,
+from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLERANCE_SD, HIDDEN_FRUIT_MIN,
+                                               HIDDEN_SCORE_MAX, LANE_FRUIT_MIN, LOT_IMPULSE_SD, LOT_STIFFNESS_SD,
+                                               NEW_FRUIT_EXCLUDED, ORPHAN_MARGIN, PAIR_DISTANCE_MAX, PAIR_MARGIN,
+                                               SLOW_PARENT_RATIO, LaneFruit, impulse_distance, judge_unmeasured,
                                                landed_with_rebound, lane_fruit, rebound_of_a_rebound,
                                                rebounds_landed_together, too_light_for_fruit, unmeasured_fruit)
-from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, LOT_RESTITUTION_SD,
-                                                   QUIET_LANE_FRUIT, claimed_parent, expected_rebound,
-                                                   hidden_rebound, judge, likeliest_hidden, rebound_pulse,
-                                                   rebounds_due)
+from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, HELD_FRUIT_SHARE,
+                                                   LOT_RESTITUTION_SD, QUIET_LANE_FRUIT, claimed_parent,
+                                                   expected_rebound, held_alternative, hidden_rebound, judge,
+                                                   likeliest_hidden, reassigned, rebound_pulse, rebounds_due,
+                                                   without_held)
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
                                                  flight_time, from_indices, landing_speed, refine, shape_table)
 
 __all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
-           "HIDDEN_FRUIT_MIN",
+           "HELD_FRUIT_SHARE", "HIDDEN_FRUIT_MIN", "HIDDEN_SCORE_MAX", "NEW_FRUIT_EXCLUDED", "held_alternative",
+           "impulse_distance", "reassigned", "without_held",
            "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
            "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
            "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",

@@ -96,22 +96,28 @@ def judge(candidate: PulseSummary, earlier: list[PulseSummary], *, max_flight: f
     best = min((_hypothesis(candidate, p) for p in parents), key=lambda ev: ev["score"], default=None)
     if best is None or not best["score"] <= threshold:
         other = reassigned(candidate, earlier, threshold, max_flight) \
-            or held_alternative(candidate, parents, threshold)
+            or held_alternative(candidate, parents, earlier, threshold)
         if other is not None:
             other.evidence["feed_prior"] = prior
             return other
     if best is None:
         return NEW_FRUIT
     score = best["score"]
-    best["threshold"] = threshold
+    _finish(best, threshold)
     best["feed_prior"] = prior
-    best["score"] = round(score, 3) if math.isfinite(score) else None
     rebound = score <= threshold
     ambiguous = AMBIGUOUS[0] * threshold < score <= AMBIGUOUS[1] * threshold
     if not rebound and not ambiguous:
         return NEW_FRUIT
     return Verdict(rebound, best["parent"] if rebound else None, ambiguous,
                    best["speed_ratio"] if rebound else None, best)
+
+
+def _finish(evidence: dict, threshold: float) -> None:
+    """The evidence of a verdict as reported: the threshold it was judged by, the score rounded (None if not
+    finite)."""
+    evidence["threshold"] = threshold
+    evidence["score"] = round(evidence["score"], 3) if math.isfinite(evidence["score"]) else None
 
 
 def reassigned(candidate: PulseSummary, earlier: list[PulseSummary], threshold: float,
@@ -143,8 +149,7 @@ def reassigned(candidate: PulseSummary, earlier: list[PulseSummary], threshold: 
     if not options:
         return None
     worst, mine, theirs, claimant = min(options, key=lambda option: option[0])
-    mine["threshold"] = threshold
-    mine["score"] = round(mine["score"], 3)
+    _finish(mine, threshold)
     mine["reassigned"] = {"contact": claimant.sequence, "was_rebound_of": mine["parent"],
                           "rebound_of": theirs["parent"], "score": round(theirs["score"], 3),
                           "speed_ratio": theirs["speed_ratio"],
@@ -177,28 +182,35 @@ def without_held(parent: PulseSummary) -> PulseSummary | None:
                    held=None)
 
 
-def held_alternative(candidate: PulseSummary, parents: list[PulseSummary], threshold: float) -> Verdict | None:
+def held_alternative(candidate: PulseSummary, parents: list[PulseSummary], earlier: list[PulseSummary],
+                     threshold: float) -> Verdict | None:
     """``candidate`` as the rebound of a fruit that landed together with a rebound due in its contact, within a
     fraction of a millisecond (one pulse to a joint fit too, so the contact was read as one fruit, its impulse
     and peak those of both).  The fruit's own rebound then fails the tests against the contact as measured (its
     speed ratio, read from the impulses, comes out too low by the held share) but passes them against the fruit
     alone (``without_held``).  The physics bounds it as for any parent: r cannot exceed the fruit's e by more
     than the tolerance, so a lone fruit (whose due rebound landed elsewhere) is not claimed through this.  The
-    verdict is said to be ambiguous; its evidence names the rebound held.  None when no such parent passes."""
+    verdict is said to be ambiguous; its evidence names the rebound held, whose parent (still free in
+    ``earlier``: its rebound not seen elsewhere) the analysis then marks taken.  None when no such parent
+    passes."""
+    free = {p.sequence for p in earlier if not p.rebound_taken}
     options = []
     for parent in parents:
-        alone = without_held(parent) if not parent.virtual else None
+        if parent.virtual or parent.held is None or parent.held[2] not in free:  # its rebound seen elsewhere
+            continue
+        alone = without_held(parent)
         if alone is not None:
             evidence = _hypothesis(candidate, alone)
-            if evidence["score"] <= threshold:
-                options.append(evidence)
+            # a hard bound, not only a tolerance: the fruit cannot come back faster than e V (+ 10 %: the spread
+            # that the held rebound's prediction adds to r would otherwise let a light lively fruit through)
+            if evidence["score"] <= threshold \
+                    and evidence["speed_ratio"] <= (1.0 + TOLERANCES["speed_ratio_up"]) * alone.restitution:
+                options.append((evidence, parent))
     if not options:
         return None
-    best = min(options, key=lambda ev: ev["score"])
-    parent = next(p for p in parents if p.sequence == best["parent"] and p.held is not None)
+    best, parent = min(options, key=lambda option: option[0]["score"])
     impulse, peak, held_parent = parent.held
-    best["threshold"] = threshold
-    best["score"] = round(best["score"], 3)
+    _finish(best, threshold)
     best["held_rebound"] = {"rebound_of": held_parent, "impulse": impulse, "peak_force": peak,
                             "reason": f"contact #{parent.sequence} was read as one fruit while the rebound of "
                                       f"#{held_parent} was due in it and not seen elsewhere: judged as that "
