@@ -532,6 +532,13 @@ def test_a_ctrl_c_inside_the_import_system_is_delivered_after_it():
         cli._deliver_interrupt(signal.SIGINT, sys._getframe())
 
 
+def _before_the_program(err: str) -> bool:
+    """Whether ``err`` is CPython's own report of an interrupt during its start-up, before the program's first line:
+    "Fatal Python error: init_import_site" (Python/pylifecycle.c) or "Could not import runpy module"
+    (Modules/main.c)."""
+    return err.startswith(("Fatal Python error: init_import_site", "Could not import runpy module"))
+
+
 def test_sigint_during_numba_start_up_exits_130_not_by_the_signal():
     """24 real SIGINTs 0.55–0.90 s into `fruitimpact simulate` (numba's start-up and cache loading on this
     machine): never exit status -2, the process killed by the signal after it had printed "interrupted" (4 of 72
@@ -545,16 +552,23 @@ def test_sigint_during_numba_start_up_exits_130_not_by_the_signal():
 
     from conftest import console_script, sigint_default
 
-    statuses = []
+    statuses, before_start = [], 0
     for k in range(24):
         process = subprocess.Popen([console_script(), "simulate", "--model", "tsuji-clamped"],
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default)
         time.sleep(0.55 + 0.35 * k / 23)
         process.send_signal(signal.SIGINT)
         out, err = process.communicate(timeout=60)
+        if _before_the_program(err):
+            # on a machine loaded past its cores the signal can land while the interpreter itself still starts
+            # (its site module, runpy), before any line of the program runs: Python's own exit, no program can
+            # handle it (seen with two test suites and a benchmark on two cores); not what this test is about
+            before_start += 1
+            continue
         assert "Traceback" not in err, err
         statuses.append(process.returncode)
     assert -signal.SIGINT not in statuses, statuses
+    assert before_start <= 4, f"{before_start} of 24 signals landed before the interpreter had started"
 
 
 @pytest.mark.parametrize("delay", [0.15, 0.3, 0.6])
@@ -571,6 +585,9 @@ def test_sigint_to_the_console_script_never_shows_a_traceback(delay):
     time.sleep(delay)
     process.send_signal(signal.SIGINT)
     out, err = process.communicate(timeout=60)
+    if _before_the_program(err):  # the interpreter itself was still starting
+        pytest.skip("the signal landed before the interpreter ran a line of the program (a machine loaded past its "
+                    "cores): Python's own exit")
     assert "Traceback" not in err, err
     assert process.returncode in (0, 130), (process.returncode, err)
     if process.returncode == 130:

@@ -346,6 +346,14 @@ class LineAnalyzer:
             together, together_parents = landed if landed is not None else (None, None)
             found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None and due else None
             pair, pair_parents = found if found is not None else (None, None)
+        elif piece and not rebound and status == "ok" and summary is not None:
+            # a piece of a split judged a new fruit may be two rebounds the joint fit took for one pulse (a fruit and
+            # two rebounds 1-2 ms apart, fitted as two pulses: seen on tests/linegen.py's chain10 at seed 36); the
+            # rebounds due in the piece itself, after the pieces before it have taken theirs
+            piece_due = rebounds_due(summary.onset, summary.separation, history, max_flight=analysis.flight_limit)
+            found = rebounds_landed_together(summary, piece_due, self._lane_fruit(impact.lane)) \
+                if len(piece_due) >= 2 else None
+            pair, pair_parents = found if found is not None else (None, None)
         orphan = None
         if not rebound and status == "ok" and summary is not None and together is None and pair is None:
             orphan = too_light_for_fruit(summary, self._lane_fruit(impact.lane))
