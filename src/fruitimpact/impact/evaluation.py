@@ -313,21 +313,19 @@ def _evaluate(inputs: InputColumns, messages: MessageBook, tabulated, detail, cl
                      "computed exactly (method accurate)", "method")
     if rk4.any():
         limit = max_rk4_step(mass, stiffness, velocity)
-        too_coarse = rk4 & ~messages.flagged & ~(step <= limit)
-        if too_coarse.any():
-            text = RK4_STEP_REFUSAL
-            if detail:
-                text = (f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
-                        f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact); got {float(step[0])!r}")
-            messages.set(too_coarse, text, "step")
         finest = limit * RK4_MIN_STEPS_PER_CONTACT / RK4_MAX_STEPS
-        too_fine = rk4 & ~messages.flagged & (step < finest)
-        if too_fine.any():
-            text = RK4_FINE_STEP_REFUSAL
-            if detail:
-                text = (f"step must be in [{float(finest[0]):.3g}, {float(limit[0]):.3g}] s for this impact (at most "
-                        f"{RK4_MAX_STEPS:,} steps per contact); got {float(step[0])!r}")
-            messages.set(too_fine, text, "step")
+
+        def refuse(bad, text, detailed):  # ``detailed``: one impact's message, naming its own range
+            bad = rk4 & ~messages.flagged & bad
+            if bad.any():
+                messages.set(bad, detailed() if detail else text, "step")
+
+        refuse(~(step <= limit), RK4_STEP_REFUSAL,
+               lambda: f"step must be in (0, {float(limit[0]):.3g}] s for this impact (at least "
+                       f"{RK4_MIN_STEPS_PER_CONTACT} steps per contact); got {float(step[0])!r}")
+        refuse(step < finest, RK4_FINE_STEP_REFUSAL,
+               lambda: f"step must be in [{float(finest[0]):.3g}, {float(limit[0]):.3g}] s for this impact (at most "
+                       f"{RK4_MAX_STEPS:,} steps per contact); got {float(step[0])!r}")
 
     law_stiffness = np.full(rows, np.nan)
     factor = np.full(rows, np.nan)
