@@ -250,7 +250,7 @@ SYNTH_LOT = dict(interval=0.25, mass="115g", diameter="65mm", modulus="3MPa", po
 def test_analyze_has_the_same_columns_for_any_recording(options):
     """A table's columns do not depend on what a recording holds: every report's keys, as the push-style
     analyzer builds them, are columns and come in the table's order; a quiet recording gives the same columns."""
-    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.reports import public
     from fruitimpact.signals.options import analysis_settings
 
     recording, _ = fi.synthesize(fi.SensorModel(seed=1, noise=0.01), fi.Population(count=2, seed=2, **SYNTH_LOT))

@@ -260,7 +260,7 @@ class Monitor:
         return curve
 
     def _report(self, report: dict) -> None:
-        from fruitimpact.signals.analysis import public
+        from fruitimpact.signals.reports import public
 
         now = time.monotonic()
         start = report.get("raw_start_time", report.get("start_time"))

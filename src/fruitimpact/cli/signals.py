@@ -133,7 +133,7 @@ def cmd_analyze(args) -> int:
         print(f"{PROG} analyze: warning: {args.file}: {note}", file=sys.stderr, flush=True)
     settings, analysis = analysis_from(args, source.rate)  # the options against the file's own rate
     from fruitimpact.signals import offline  # the detector and the fit (numba) once the file opened and the options hold
-    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.reports import public
     from fruitimpact.signals.stream import StreamAnalyzer
 
     keep = bool(args.plot)  # a figure of the recording needs its samples and windows
@@ -416,7 +416,7 @@ def cmd_stream(args) -> int:
     if args.listen is not None:
         port = read_option_count("--listen", args.listen, 0, 65535)
     settings, analysis = analysis_from(args, rate)  # plain checks first: a usage error imports no numba
-    from fruitimpact.signals.analysis import public
+    from fruitimpact.signals.reports import public
     from fruitimpact.signals.stream import StreamAnalyzer, iter_chunks, serve
 
     def emit(report):

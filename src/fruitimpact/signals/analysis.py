@@ -38,7 +38,7 @@ import numpy as np
 
 
 from fruitimpact.signals.detect import DetectedImpact
-from fruitimpact.signals.indices import INDEX_KEYS, impact_indices, second_pulse
+from fruitimpact.signals.indices import impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
                                          Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
                                          judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
@@ -46,16 +46,12 @@ from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_
                                          rebounds_landed_together, refine, shape_table, too_light_for_fruit,
                                          unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
+from fruitimpact.signals.reports import (FIRMNESS_KEYS, SUMMARY_KEYS, UNSPLIT, detector_status, is_finite_number,
+                                        merge_fit, restated, shape_fit, without_firmness)
 from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
 
-#: Keys of a fit that join the report (a contract: analyze --fit).
-FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
-#: Keys of every report beside the indices (a contract of analyze --json and stream).
-REPORT_KEYS = ("sequence", "status", "message", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence")
 #: A second rise (or an earlier fall) larger than this share of the peak is a second fruit in the contact.
 OVERLAP_FRACTION = 0.10
-#: Firmness indices withheld from an overlap (they would describe neither fruit).
-FIRMNESS_KEYS = ("firmness_c", "firmness_c_star")
 #: A contact in which a rebound is due (``rebounds.rebounds_due``) but that one pulse fits is split only when two
 #: pulses fit it better by this much (χ² per sample, in noise variances; ``_split_gain``): over ~240 samples that
 #: is Δχ² ≈ 50 for 4 more parameters, far beyond chance.  Measured on the line scenarios of tests/linegen.py
@@ -73,8 +69,6 @@ MAX_DUE = 3
 #: at p95, and their errors are of that size (0.4 %, 2.2 %); at 3 % the pieces' peaks were 1.5 % off at p95 (chain10,
 #: noisy), at 1 % 0.9 %.  Two fruit 1.5–2 ms apart with no rebound due are fixed only to ±2–6 %.
 PIECE_PRECISION = 0.01
-#: Marks a fit restated for a rebound whose first impact's speed is unknown (``_restated``): shape only.
-UNSPLIT = "_unsplit"
 #: Marks a piece of a split in which a third pulse was found but not told apart (``_split_further``).
 HOLDS_TWO = "_holds_two"
 #: Starts fitted when a piece of a split is tried as two pulses again (rare, and it delays the report).
@@ -123,30 +117,30 @@ class LineAnalyzer:
         analysis = self.analysis
         own = isolated(impact)
         report = impact_indices(own, analysis.rate)
-        status, message = _status(impact)
+        status, message = detector_status(impact)
         peak = report["peak_force"]
         second = second_pulse(own)
         shape = None
-        if _finite(peak) and peak > 0 and second > OVERLAP_FRACTION * peak:
+        if is_finite_number(peak) and peak > 0 and second > OVERLAP_FRACTION * peak:
             status = "overlap"
             message = (f"two pulses in one contact: the force falls and rises again by {second:.3g} N "
                        f"({second / peak:.0%} of the peak): two fruit, or a fruit and a rebound; no firmness")
         elif status in ("ok", "clipped"):
-            shape = _shape_fit(own, analysis)
+            shape = shape_fit(own, analysis)
             residual = shape.get("fit_residual", math.nan)
             misfit = math.sqrt(max(residual ** 2 - impact.noise ** 2, 0.0)) / peak \
-                if _finite(residual) and _finite(peak) and peak > 0 else math.nan
+                if is_finite_number(residual) and is_finite_number(peak) and peak > 0 else math.nan
             if misfit > MISFIT_LIMIT:  # converged or not: no single pulse fits
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
                            f"(one fruit: at most {MISFIT_LIMIT:.1%}): two fruit landing together; no firmness")
         parts = None
         due = []
-        if _finite(report["start_time"]):
+        if is_finite_number(report["start_time"]):
             onset = report["start_time"]
             # a contact holding several pulses may have no clean falling edge (its indices' duration NaN): then
             # the contact as detected, up to its last sample above the threshold, is where a rebound may be due
-            end = onset + report["contact_duration"] if _finite(report["contact_duration"]) \
+            end = onset + report["contact_duration"] if is_finite_number(report["contact_duration"]) \
                 else (impact.end_index + 1) / analysis.rate
             due = rebounds_due(onset, end, self._history.get(impact.lane, []), max_flight=analysis.flight_limit)
         if status == "overlap" and not (impact.truncated or impact.overlong or impact.clipped):
@@ -200,7 +194,7 @@ class LineAnalyzer:
                     if reports[-1]["rebound"] and not spread <= PIECE_PRECISION:
                         # a rebound is graded with its fruit, so the piece stays with its parent, but its amplitude
                         # traded off against the other pulse's: neither its peak nor its fit is a measurement
-                        _without_firmness(reports[-1], fit=True)
+                        without_firmness(reports[-1], fit=True)
                         if "fit_converged" in reports[-1]:
                             reports[-1].update(fit_converged=False, fit_message="a joint fit of two pulses, whose "
                                                "amplitudes trade off: not a fit of this rebound alone")
@@ -209,7 +203,7 @@ class LineAnalyzer:
                             f"its peak force is determined to ±{spread:.1%} only (at most ±{PIECE_PRECISION:.0%})"))
             return reports
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
-            _without_firmness(report)
+            without_firmness(report)
             inside = own.window[impact.start_index - own.window_start:impact.end_index + 1 - own.window_start]
             report.update(start_time=impact.start_index / analysis.rate,
                           time_to_peak=(impact.peak_index - impact.start_index) / analysis.rate,
@@ -377,11 +371,11 @@ class LineAnalyzer:
             status, chosen, summary, hidden_fruit = "overlap", None, None, False
             held = "a rebound" if len(together["parents"]) == 1 else "two rebounds"
             message = f"a fruit and {held} landing together: {together['reason']}; no firmness"
-            _without_firmness(report)
+            without_firmness(report)
         elif pair is not None:  # no fruit at all: two rebounds, each of its own parent
             status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
-            _without_firmness(report)
+            without_firmness(report)
         speed = self.line_speed(impact.lane)
         read = analysis.velocity is None  # a speed read from the lane's rebounds: no flight is tested against it
         landing = math.nan  # the impact speed its own flight shows, for its next bounce (a hidden fruit's rebound)
@@ -420,19 +414,19 @@ class LineAnalyzer:
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None),
                       rebound_evidence=chosen.evidence if chosen is not None else together or pair or orphan)
         if analysis.fit and shape is not None and status != "overlap":
-            result = _restated(shape, analysis, speed)
-            _merge_fit(report, result)
+            result = restated(shape, analysis, speed)
+            merge_fit(report, result)
             if not result.get("converged") and status == "ok":
                 status, message = "unfitted", f"the fit did not converge: {result.get('message', '')}"
             elif result.get(UNSPLIT):
                 report["_fit"] = shape  # its curve (at V = 1 m/s, the same pulse) is still the one to draw
                 message = message or result["message"]
-            if speed is None and result.get("converged") and _finite(result.get("velocity")):
+            if speed is None and result.get("converged") and is_finite_number(result.get("velocity")):
                 speed, read = result["velocity"], False  # the mass was given: the fit found the speed
         if summary is not None:
             # a hidden fruit's rebound: its flight from the overlap fixes the speed it landed at, so its own bounce
             # can be expected (``rebounds_due``) and its flight tested; the fit still leaves its m and K unsplit
-            kept = summary.with_velocity(landing, False) if speed is None and _finite(landing) \
+            kept = summary.with_velocity(landing, False) if speed is None and is_finite_number(landing) \
                 else summary.with_velocity(speed, read)
             if not rebound and status == "ok" and orphan is None and due:
                 # a new fruit while a rebound was due in it: that rebound may have landed with it, too close to
@@ -485,7 +479,7 @@ class LineAnalyzer:
         if analysis.classes is not None:
             graded = not rebound and status not in ("overlap", "truncated")
             value = report.get(analysis.classes.by, math.nan)
-            report["class"] = analysis.classes.classify([value if _finite(value) else math.nan])[0] \
+            report["class"] = analysis.classes.classify([value if is_finite_number(value) else math.nan])[0] \
                 if graded else None
             report["class_by"] = analysis.classes.by
         report["status"] = status
@@ -634,7 +628,7 @@ def _warm_up(analysis: Analysis) -> None:
                                 window_start=0, window=window, emitted_at=n)
         impact_indices(impact, rate)
         second_pulse(impact)
-        fit = _shape_fit(impact, analysis)
+        fit = shape_fit(impact, analysis)
         if fit.get("converged") and fit.get("velocity_stderr") == 0.0:
             at_velocity(fit, 1.0)
         split_contact(t, window, 0.01, velocity=1.0)
@@ -663,7 +657,7 @@ def _split_gain(shape: dict, parts, impact: DetectedImpact) -> float:
     """How much better two pulses fit the contact's window than one: the drop of χ² per sample, in units of
     the noise variance ((rms₁² − rms₂²)/σ²; both fits are over the same samples)."""
     one, two = shape.get("fit_residual", math.nan), parts[0][1].get("fit_residual", math.nan)
-    if not (_finite(one) and _finite(two) and impact.noise > 0):
+    if not (is_finite_number(one) and is_finite_number(two) and impact.noise > 0):
         return 0.0
     return (one ** 2 - two ** 2) / impact.noise ** 2
 
@@ -676,17 +670,6 @@ def _imprecise(parts, rebounds) -> float | None:
     worst = max((_relative_peak_error(fit) for (_, fit), rebound in zip(parts, rebounds) if not rebound),
                 default=0.0)
     return worst if not worst <= PIECE_PRECISION else None
-
-
-def _without_firmness(report: dict, fit: bool = False) -> None:
-    """Blank a report's firmness (an overlap has none): the indices' and their measured ``raw_`` values, and with
-    ``fit`` the fitted values and their standard errors too (a piece whose fit is no measurement)."""
-    keys = (*FIRMNESS_KEYS, *(f"raw_{key}" for key in FIRMNESS_KEYS))
-    if fit:
-        keys += tuple(k for key in FIT_KEYS for k in (key, f"{key}_stderr"))
-    for key in keys:
-        if key in report or key in FIRMNESS_KEYS:
-            report[key] = math.nan
 
 
 def _relative_peak_error(fit: dict) -> float:
@@ -702,60 +685,7 @@ def _may_split(shape: dict, impact: DetectedImpact) -> bool:
     rebound was due and none of the fruit and rebounds that were then told apart (their single fits left
     ≥ 1.2 σ²)."""
     residual = shape.get("fit_residual", math.nan)
-    return _finite(residual) and impact.noise > 0 and residual ** 2 >= (0.95 + SPLIT_GAIN) * impact.noise ** 2
-
-
-def _status(impact: DetectedImpact) -> tuple[str, str]:
-    if impact.truncated:
-        return "truncated", "the stream ended during this contact: its indices are incomplete"
-    if impact.overlong:
-        return "overlong", "the contact lasted longer than the detector's max_duration: ended there"
-    if impact.clipped:
-        return "clipped", "the signal reached the acquisition's limits during this contact: the peak is a lower bound"
-    return "ok", ""
-
-
-#: Indices a rebound test reads (``rebounds.from_indices``).
-SUMMARY_KEYS = ("start_time", "peak_force", "time_to_peak", "impulse")
-#: Indices the fit restates (the measured ones kept as ``raw_<key>``).
-RESTATED_KEYS = ("start_time", "peak_force", "time_to_peak", "contact_duration", "firmness_c", "firmness_c_star",
-                 "impulse")
-
-
-def report_columns(analysis: Analysis) -> tuple[str, ...]:
-    """Every key a report of ``analysis`` may have, in the order a report builds them: the columns of
-    ``analyze``'s table whichever contacts a recording holds (a fit that did not converge on any contact, or a
-    quiet recording, still gives the columns)."""
-    columns = [*INDEX_KEYS, "sequence", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence"]
-    if analysis.fit:
-        columns += [f"raw_{key}" for key in RESTATED_KEYS]
-        for key in FIT_KEYS:
-            columns += [key, f"{key}_stderr"]
-        columns += ["fit_residual", "fit_residual_relative", "fit_converged", "fit_message"]
-    if analysis.classes is not None:
-        columns += ["class", "class_by"]
-    return (*columns, "status", "message")
-
-
-def _merge_fit(report: dict, result: dict) -> None:
-    for key in RESTATED_KEYS:
-        if key in result and result.get("converged") and _finite(result[key]):
-            report[f"raw_{key}"] = report.get(key)
-            report[key] = result[key]
-    for key in FIT_KEYS:
-        if key in result:
-            report[key] = result[key]
-            report[f"{key}_stderr"] = result.get(f"{key}_stderr", math.nan)
-    report["fit_residual"] = result.get("fit_residual", math.nan)
-    report["fit_residual_relative"] = result.get("fit_residual_relative", math.nan)
-    report["fit_converged"] = bool(result.get("converged", False))
-    report["fit_message"] = result.get("message", "")
-    report["_fit"] = result  # the whole fit (for figures); not part of the JSON
-
-
-def public(report: dict) -> dict:
-    """The JSON object of a report: without its private entries (the whole fit)."""
-    return {key: value for key, value in report.items() if not key.startswith("_")}
+    return is_finite_number(residual) and impact.noise > 0 and residual ** 2 >= (0.95 + SPLIT_GAIN) * impact.noise ** 2
 
 
 def _score(verdict: Verdict) -> float:
@@ -764,41 +694,4 @@ def _score(verdict: Verdict) -> float:
     return float(score) if score is not None else math.inf
 
 
-def _finite(value) -> bool:
-    return isinstance(value, (int, float, np.floating)) and math.isfinite(float(value))
-
-
-def _shape_fit(impact: DetectedImpact, analysis: Analysis) -> dict:
-    """The simulator's pulse fitted to the contact's own samples: with the given mass, or at a unit
-    velocity (the shape, indices and relative errors do not depend on it; ``_restated`` splits the
-    Hertz scales for the contact's real speed)."""
-    from fruitimpact.signals.fit import fit_impact
-
-    time = (impact.window_start + np.arange(impact.window.size)) / analysis.rate
-    # the detector records the next contact's onset only when it began inside this one's window, and ``isolated``
-    # then stops the window before that contact's rise: possibly before this contact's own tail
-    cut = impact.next_start is not None
-    try:
-        return fit_impact(time, impact.window, velocity=1.0 if analysis.mass is None else None,
-                          mass=analysis.mass, diameter=analysis.diameter, poisson=analysis.poisson,
-                          noise=impact.noise or None, open_end=cut)
-    except ValueError as exc:  # one bad pulse never stops the others
-        return {"converged": False, "message": f"fit refused: {exc}"}
-
-
-def _restated(shape: dict, analysis: Analysis, velocity) -> dict:
-    """The shape fit for this contact's knowns: the given mass as it is, else its impact speed."""
-    from fruitimpact.signals.fit import at_velocity
-
-    if analysis.mass is not None or not shape.get("converged"):
-        return shape
-    if velocity is None:  # the pulse's shape (peak, times, e: c V is fitted as one) holds; m and K do not split
-        unsplit = {name: math.nan for name in ("mass", "stiffness", "modulus", "velocity")}
-        unsplit.update({f"{name}_stderr": math.nan for name in unsplit})
-        return {**shape, **unsplit, UNSPLIT: True,
-                "message": "a rebound whose first impact's speed is unknown: its mass and stiffness are not split "
-                           "(peak force, times and restitution are the pulse fit's)"}
-    return at_velocity(shape, velocity)
-
-
-__all__ = ["Analysis", "FIT_KEYS", "LineAnalyzer", "REPORT_KEYS", "isolated", "public"]
+__all__ = ["Analysis", "LineAnalyzer", "isolated"]

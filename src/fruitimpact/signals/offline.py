@@ -97,7 +97,7 @@ def run_analysis(source, *, rate=None, column: str | None = None, format: str | 
     import numpy as np
 
     from fruitimpact.impact.validation import InputError, check_integer
-    from fruitimpact.signals.analysis import public, report_columns
+    from fruitimpact.signals.reports import public, report_columns
     from fruitimpact.signals.options import analysis_settings
     from fruitimpact.signals.read import open_recording
     from fruitimpact.signals.recording import Recording
