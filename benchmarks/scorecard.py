@@ -26,7 +26,7 @@ matrix and the share of fruit ≥ 5 % from a threshold that get the right class 
 kinds, at benchmark size), two at a time; one line per recording and the totals (recordings short of full recall,
 extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit reported as overlaps).
 ``--variants``: the same at other settings of the generator (``VARIANTS``: flights ±20 %, spin to 15 %, 10 kHz,
-twice the noise, 3 and 6 cm drops), at seeds 1,2 or ``--seeds``.
+twice the noise, 3 and 6 cm drops, a restitution that does not change with speed), at seeds 1,2 or ``--seeds``.
 
 The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
 """
@@ -165,7 +165,8 @@ def _seeds(text: str) -> list[int]:
 #: Other settings of the same generator (``--variants``): what a line that differs from the scenarios' own does
 #: to the goals.  Each (scenario, changes): flights off by ±20 % (the issue's upper bound for spin and off-axis
 #: bounces), spin taking up to 15 % of the rebound's speed, a 10 kHz acquisition, twice the noise, drops of 3 and
-#: 6 cm (the issue's 30–60 mm).
+#: 6 cm (the issue's 30–60 mm), and fruit whose restitution is the same at every speed (``linegen.DAMPING_LAWS``:
+#: Lankarani–Nikravesh, Flores), where the Hunt–Crossley fruit of the scenarios come back livelier.
 VARIANTS = {
     "chain10/flight±20%": ("chain10", {"flight_jitter": 0.20}),
     "chain10/spin≤15%": ("chain10", {"spin_loss": (0.0, 0.15)}),
@@ -175,6 +176,9 @@ VARIANTS = {
     "close/3cm": ("close", {"drop_height": 0.03}),
     "chain7/6cm": ("chain7", {"drop_height": 0.06}),
     "pears3cm/6cm": ("pears3cm", {"drop_height": 0.06}),
+    "chain10/LN": ("chain10", {"damping_law": "lankarani-nikravesh"}),
+    "chain7/Flores": ("chain7", {"damping_law": "flores"}),
+    "close/Flores": ("close", {"damping_law": "flores"}),
 }
 
 
@@ -232,7 +236,8 @@ def main(argv=None) -> int:
                                                          "a line per recording and the totals")
     parser.add_argument("--variants", action="store_true",
                         help="other settings of the generator (VARIANTS: flights ±20 %%, spin to 15 %%, 10 kHz, "
-                             "noise ×2, 3 and 6 cm drops) at seeds 1,2 (or --seeds): a line per recording")
+                             "noise ×2, 3 and 6 cm drops, constant-restitution damping) at seeds 1,2 (or "
+                             "--seeds): a line per recording")
     args = parser.parse_args(argv)
     names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
     unknown = [n for n in names if n not in lg.SCENARIOS]

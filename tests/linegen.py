@@ -10,7 +10,9 @@ Physics of one contact (Hunt–Crossley sphere on a rigid plate)
     c [s/m] is a material constant of the fruit: the restitution e = V_out / V falls as c V grows (c V = 0.6 →
     e = 0.71, 1.0 → 0.59, 1.75 → 0.45), so a rebound at the lower speed e V has a higher restitution.  Integrated
     by ``solve_ivp`` (DOP853, rtol 1e-10) from δ = 0 with two events: the force maximum (dF/dt = 0) and the
-    separation (δ back to 0).  The force is tabulated on a fine grid (8193 points over the contact) and
+    separation (δ back to 0).  ``damping_law`` (``DAMPING_LAWS``) may instead make the restitution the fruit's
+    constant (c = χ(e₀)/V per contact: Lankarani–Nikravesh, Flores): a rebound is then as lively as its fruit.
+    The force is tabulated on a fine grid (8193 points over the contact) and
     interpolated at the recording's (oversampled) sample times, so onsets fall anywhere between samples.
 
 Feed (per lane)
@@ -242,6 +244,7 @@ class Scenario:
     flight_jitter: float = 0.10                 # uniform ± fraction of the flight 2 V_up / g
     spin_loss: tuple[float, float] = (0.0, 0.04)  # uniform fraction of V_up lost before the rebound lands
     spot_stiffness: float = 0.05                # uniform ± fraction of K where a rebound lands
+    damping_law: str = "hunt-crossley"          # how c depends on the contact's speed (``DAMPING_LAWS``)
     kinds: tuple[tuple[FruitKind, float], ...] = ((APPLE, 1.0),)  # kinds and their shares
     drop_height: float = 0.05                   # [m]
     noise: float = 0.01                         # white-noise σ / median primary peak
@@ -299,6 +302,19 @@ def _lognormal(rng, median: float, sigma: float, bounds: tuple[float, float]) ->
     raise RuntimeError("lognormal bounds too narrow")
 
 
+#: How a contact's damping c [s/m] follows from the fruit and the contact's speed v [m/s] (``Scenario.damping_law``).
+#: ``hunt-crossley``: c is the fruit's material constant, so a rebound (slower) has a higher restitution.  The two
+#: others make the restitution a constant of the fruit, whatever the speed: e₀ is the Hunt–Crossley restitution of
+#: that fruit at the line's speed V (the populations keep their range of e at V), and c = χ(e₀) / v with
+#: ``lankarani-nikravesh`` χ = 3 (1 − e₀²) / 4 (Lankarani & Nikravesh 1990; derived for e₀ near 1, so its real
+#: restitution is higher than e₀ for soft fruit) and ``flores`` χ = 8 (1 − e₀) / (5 e₀) (Flores et al. 2011).
+DAMPING_LAWS = {
+    "hunt-crossley": lambda fruit, v: fruit["damping"],
+    "lankarani-nikravesh": lambda fruit, v: 3.0 * (1.0 - fruit["e0"] ** 2) / (4.0 * v),
+    "flores": lambda fruit, v: 8.0 * (1.0 - fruit["e0"]) / (5.0 * fruit["e0"] * v),
+}
+
+
 def draw_fruit(rng, kind: FruitKind) -> dict:
     """One fruit of ``kind``: mass [kg], diameter [m], modulus [Pa], poisson, damping c [s/m], K [N/m^1.5]."""
     if kind.diameter is not None:
@@ -354,7 +370,10 @@ def _contacts(scenario: Scenario, size: int, rng) -> tuple[list[dict], list[dict
                 start = first_slot + k * pitch + rng.uniform(-1.0, 1.0) * scenario.pitch_jitter * pitch
                 if previous_end is not None and start <= previous_end:  # cannot happen at these pitches
                     start = previous_end + scenario.close_gap[1]
-            pulse = contact(fruit["stiffness"], fruit["mass"], fruit["damping"], V)
+            damping_of = DAMPING_LAWS[scenario.damping_law]
+            if scenario.damping_law != "hunt-crossley":
+                fruit["e0"] = contact(fruit["stiffness"], fruit["mass"], fruit["damping"], V).restitution
+            pulse = contact(fruit["stiffness"], fruit["mass"], damping_of(fruit, V), V)
             primary = dict(lane=lane, lane_name=names[lane], fruit_id=fruit_id, kind=fruit["kind"], start_time=start,
                            pulse=pulse, is_rebound=False, parent=None, close_arrival=bool(close), flight_time=None,
                            modulus=fruit["modulus"], diameter=fruit["diameter"], poisson=fruit["poisson"])
@@ -370,7 +389,7 @@ def _contacts(scenario: Scenario, size: int, rng) -> tuple[list[dict], list[dict
                 flight = 2.0 * v_up / G * (1.0 + rng.uniform(-1.0, 1.0) * scenario.flight_jitter)
                 v2 = v_up * (1.0 - rng.uniform(*scenario.spin_loss))
                 k2 = fruit["stiffness"] * (1.0 + rng.uniform(-1.0, 1.0) * scenario.spot_stiffness)
-                p2 = contact(k2, fruit["mass"], fruit["damping"], v2)
+                p2 = contact(k2, fruit["mass"], damping_of(fruit, v2), v2)
                 rebound = dict(lane=lane, lane_name=names[lane], fruit_id=fruit_id, kind=fruit["kind"],
                                start_time=parent["start_time"] + parent["pulse"].duration + flight, pulse=p2,
                                is_rebound=True, parent=parent, close_arrival=False, flight_time=flight,

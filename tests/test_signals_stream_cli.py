@@ -131,14 +131,15 @@ def test_sigterm_mid_file_ends_analyze_with_whole_lines_only(tmp_path):
 def test_stream_equals_analyze_where_a_rebound_is_read_a_second_time(cli, tmp_path):
     """The second readings of a rebound (``rebounds.reassigned``: a bounce re-read as another contact's rebound;
     ``rebounds.held_alternative``: a parent read as a fruit alone) change the analysis's books after a contact has
-    been reported.  On recordings of the independent generator (tests/linegen.py, chain10 at seeds 28 and 27) where
-    each fires, ``stream`` fed through a pipe in random pieces writes the same objects as ``analyze``."""
+    been reported.  On recordings of the independent generator (tests/linegen.py, chain10 at seeds 8 and 27) where
+    each fires (seed 28, where the re-reading was first seen, is judged right without it since a rebound's damping
+    may follow either law, ``rebounds.rebound_x``), ``stream`` fed through a pipe in random pieces writes the same objects as ``analyze``."""
     import dataclasses
 
     import linegen as lg
 
     fired = set()
-    for seed in (28, 27):
+    for seed in (8, 27):
         path, truth = lg.write(dataclasses.replace(lg.SCENARIOS["chain10"], seed=seed), tmp_path)
         options = lg.analyze_options(truth)
         status, out, err = cli.run("analyze", path, *options)

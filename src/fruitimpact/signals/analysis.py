@@ -39,12 +39,12 @@ import numpy as np
 
 from fruitimpact.signals.detect import DetectedImpact
 from fruitimpact.signals.indices import impact_indices, second_pulse
-from fruitimpact.signals.rebounds import (HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT, QUIET_LANE_FRUIT, PulseSummary,
-                                         Verdict, claimed_parent, expected_rebound, from_indices, hidden_rebound,
-                                         judge, judge_unmeasured, landed_with_rebound, likeliest_hidden,
-                                         landing_speed, rebound_of_a_rebound, rebounds_due,
-                                         rebounds_landed_together, refine, shape_table, too_light_for_fruit,
-                                         unmeasured_fruit)
+from fruitimpact.signals.rebounds import (DAMPING_EXPONENT, HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT,
+                                         QUIET_LANE_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
+                                         from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
+                                         landing_speed, likeliest_hidden, median_of, rebound_of_a_rebound,
+                                         rebounds_due, rebounds_landed_together, refine, robust_sd, shape_table,
+                                         too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.reports import (FIRMNESS_KEYS, SUMMARY_KEYS, UNSPLIT, detector_status, is_finite_number,
                                         merge_fit, restated, shape_fit, without_firmness)
@@ -84,6 +84,18 @@ LANE_FRUIT_KEPT = 15
 SPEED_MIN_REBOUNDS = 4
 SPEED_KEPT = 15
 SPEED_SPREAD = 0.15
+#: The line's damping law read from its own rebounds (``LineAnalyzer.damping_exponent``): each clear rebound of a
+#: measured contact at speed ratio r ≤ ``DAMPING_RATIO_MAX`` shows β = ln(x_r/x_p)/ln r (``rebounds.rebound_x``:
+#: 1 when the damping c is the fruit's constant, 0 when the restitution is).  Once ``DAMPING_MIN_REBOUNDS`` have,
+#: line-wide (a lot's property, not a lane's), its rebounds are judged within the median of the last
+#: ``DAMPING_KEPT`` ± 3 standard errors of that median (robust sd/√n), at least ± ``DAMPING_HALF_WIDTH``: the range
+#: is the lot's law, and one rebound's own scatter (its x measured to a few %, over ln r ≈ −0.5: a robust sd of
+#: 0.25–0.3 in β on the lines of tests/linegen.py) is the shape test's tolerance.  Without it a fruit arriving just
+#: before its predecessor's rebound, whose x lies between r x_p and x_p, passed for that rebound.
+DAMPING_MIN_REBOUNDS = 4
+DAMPING_KEPT = 15
+DAMPING_HALF_WIDTH = 0.25
+DAMPING_RATIO_MAX = 0.85
 
 
 class LineAnalyzer:
@@ -106,6 +118,8 @@ class LineAnalyzer:
         self._quiet: dict[int, int | None] = {}
         #: per lane: the impact speed [m/s] read from each clear first rebound of a new fruit (``line_speed``)
         self._speeds: dict[int, list[float]] = {}
+        #: line-wide: β of each clear rebound of a measured contact (``damping_exponent``)
+        self._exponents: list[float] = []
         #: (lane, sequence) of the overlaps whose hidden fruit's slot one contact has claimed without naming it its
         #: parent (``rebounds.judge_unmeasured``, ``new_fruit_excluded``): the next claim closes it
         self._claimed_once: set[tuple[int, int]] = set()
@@ -253,7 +267,7 @@ class LineAnalyzer:
         flags = []
         for piece, fit in parts:
             summary = from_indices(impact_indices(piece, self.analysis.rate), -1, noise, None)
-            rebound = summary is not None and judge(refine(summary, fit), history,
+            rebound = summary is not None and judge(self._judged(refine(summary, fit)), history,
                                                     max_flight=self.analysis.flight_limit,
                                                     last_fruit_onset=last_fruit, pitch=self.analysis.pitch,
                                                     quiet_fruit=self._quiet_fruit(lane)).rebound
@@ -314,7 +328,7 @@ class LineAnalyzer:
                 summary = from_indices({**report, **{key: shape.get(key) for key in SUMMARY_KEYS}}, sequence,
                                        impact.noise, None)
             if summary is not None:
-                summary = refine(summary, shape)
+                summary = self._judged(refine(summary, shape))
         history = self._history.setdefault(impact.lane, [])
         verdict = None
         if summary is not None and analysis.flight_limit > 0:
@@ -406,6 +420,7 @@ class LineAnalyzer:
             if chosen.evidence.get("held_rebound") is not None:  # the rebound held in the parent's contact was seen
                 self._held_seen(history, chosen.evidence["held_rebound"]["rebound_of"])
             self._read_speed(impact.lane, summary, parent, chosen)
+            self._read_damping(summary, parent, chosen)
             speed = _rebound_speed(chosen.speed_ratio, parent)
             read = parent.speed_read
         unnamed = hidden_fruit and chosen.evidence.get("new_fruit_excluded")  # its parent is not known
@@ -548,6 +563,33 @@ class LineAnalyzer:
             kept = self._speeds.setdefault(lane, [])
             kept.append(landing_speed(flight) / verdict.speed_ratio)
             del kept[:-SPEED_KEPT]
+
+    def damping_exponent(self) -> tuple[float, float]:
+        """The range of β (x_r = r^β x_p) the line's rebounds are judged with: ``rebounds.DAMPING_EXPONENT`` until
+        ``DAMPING_MIN_REBOUNDS`` clear rebounds have shown the line's own, then the median of the last
+        ``DAMPING_KEPT`` ± max(3 robust sd/√n, ``DAMPING_HALF_WIDTH``), within ``DAMPING_EXPONENT``."""
+        count = len(self._exponents)
+        if count < DAMPING_MIN_REBOUNDS:
+            return DAMPING_EXPONENT
+        median = median_of(self._exponents)
+        half = max(3.0 * robust_sd(self._exponents) / math.sqrt(count), DAMPING_HALF_WIDTH)
+        low, high = max(median - half, DAMPING_EXPONENT[0]), min(median + half, DAMPING_EXPONENT[1])
+        return (low, high) if low < high else DAMPING_EXPONENT
+
+    def _judged(self, summary: PulseSummary) -> PulseSummary:
+        """``summary`` with the range of β it is judged with as a rebound (``damping_exponent``)."""
+        exponent = self.damping_exponent()
+        return summary if exponent == summary.damping_exponent else \
+            dataclasses.replace(summary, damping_exponent=exponent)
+
+    def _read_damping(self, rebound: PulseSummary, parent: PulseSummary, verdict: Verdict) -> None:
+        """Keep the β a clear rebound of a measured contact shows, ln(x_r/x_p)/ln r (``damping_exponent``)."""
+        ratio = verdict.speed_ratio
+        if verdict.ambiguous or parent.virtual or not ratio or not 0.0 < ratio <= DAMPING_RATIO_MAX \
+                or not (rebound.x > 0 and parent.x > 0):
+            return
+        self._exponents.append(math.log(rebound.x / parent.x) / math.log(ratio))
+        del self._exponents[:-DAMPING_KEPT]
 
     def _lane_fruit(self, lane: int) -> list[PulseSummary]:
         """The measured new fruit that stand for the next fruit of ``lane``: its own, or, until it has

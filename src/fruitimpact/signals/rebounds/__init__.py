@@ -2,8 +2,7 @@
 (issue 13, item 1), never by "smaller and soon".
 
 A fruit that leaves the plate at V₂ flies 2 V₂/g (no drag) and lands again as the *same* fruit: the
-same mass m, contact stiffness K and Hunt–Crossley damping factor c (a material constant), at the lower
-speed.  For the force law F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale
+same mass m, contact stiffness K and damping, at the lower speed.  For the force law F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale
 times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
 
     F_max = K δ_H^1.5 · P(x)/1.25,   t_c = t_H · τ_c(x),   T = t_H · τ_T(x),   ∫F dt = m V (1 + e(x)),
@@ -11,15 +10,21 @@ times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.
 with P, τ_c, τ_T, e the dimensionless peak, time to peak, duration and restitution of the exact engine
 (m = V = 1, K = 1.25).  So if a contact j is the rebound of contact p at the speed ratio r = V_j/V_p:
 
-    x_j = r x_p,
-    F_j / F_p  = r^1.2  · P(r x_p)/P(x_p),
-    t_cj/t_cp  = r^-0.2 · τ_c(r x_p)/τ_c(x_p),
-    I_j / I_p  = r · (1 + e(r x_p))/(1 + e(x_p)),
+    x_j = r^β x_p,
+    F_j / F_p  = r^1.2  · P(x_j)/P(x_p),
+    t_cj/t_cp  = r^-0.2 · τ_c(x_j)/τ_c(x_p),
+    I_j / I_p  = r · (1 + e(x_j))/(1 + e(x_p)),
 
-none of which needs m, K or V.  The impulse ratio gives r (it does not depend on where the fruit lands on
-itself); the peak force, the time to peak and the shape x must then agree with it, r must be the
-restitution of p (r ≈ e_p: the fruit cannot come back faster, and spin or an off-axis bounce take a
-little), and, when p's impact speed is known (the line's drop height, or a fitted velocity), the
+none of which needs m, K or V.  β says how the damping follows the speed, and it is not settled for fruit:
+β = 1 when c is a material constant (Hunt–Crossley: a slower impact is livelier), β = 0 when the restitution
+is (Lankarani–Nikravesh 1990, Flores et al. 2011: c ∝ 1/V), both named by the founding paper.  The tests take
+x_j anywhere in that range (``DAMPING_EXPONENT``), nearest the contact's own measured x (``rebound_x``), until
+the line's rebounds have shown its own (``PulseSummary.damping_exponent``, read by the analysis): on lines built
+with a constant restitution, x_j = r x_p alone took 268 of their rebounds for new fruit in six recordings.
+
+The impulse ratio gives r (it does not depend on where the fruit lands on itself); the peak force, the
+time to peak and the shape x must then agree with it, r must be the restitution of p (r ≈ e_p: the fruit
+cannot come back faster, and spin or an off-axis bounce take a little), and, when p's impact speed is known (the line's drop height, or a fitted velocity), the
 observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
 
 Each test gives a deviation in units of its tolerance; the score S of the hypothesis is the largest.
@@ -32,7 +37,8 @@ Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
   is uncertain: 3 × its relative standard error is added in quadrature);
 * peak force and time to peak: 3 × √(σ_meas² + 4 %²), the 4 % for a rebound landing on another spot
   of the fruit (local radius and modulus ±10 % move F_max and t_c by ~4 %: both go as K^±0.4);
-* shape: x_j against r x_p within 3 × √(σ_j² + (r σ_p)² + (0.1 r x_p)²).
+* shape: the measured x_j against the nearest x the damping laws allow (``rebound_x``), within
+  3 × √(σ_j² + (x_j/x_p · σ_p)² + (0.1 x_j)²): 0 inside the range.
 
 S ≤ 1: a rebound.  S > 1: a new fruit.  Near the boundary (``AMBIGUOUS`` band) the decision is kept but
 flagged ambiguous, with the evidence (predicted and observed flight and peak).  A known feed
@@ -61,23 +67,25 @@ from fruitimpact.signals.rebounds.lane import (CHI2_3_99, CHI2_4_99, FLIGHT_TOLE
                                                HIDDEN_SCORE_MAX, LANE_FRUIT_MIN, LOT_IMPULSE_SD, LOT_STIFFNESS_SD,
                                                NEW_FRUIT_EXCLUDED, ORPHAN_MARGIN, PAIR_DISTANCE_MAX, PAIR_MARGIN,
                                                SLOW_PARENT_RATIO, LaneFruit, impulse_distance, judge_unmeasured,
-                                               landed_with_rebound, lane_fruit, rebound_of_a_rebound,
-                                               rebounds_landed_together, too_light_for_fruit, unmeasured_fruit)
+                                               landed_with_rebound, lane_fruit, median_of, rebound_of_a_rebound,
+                                               rebounds_landed_together, robust_sd, too_light_for_fruit,
+                                               unmeasured_fruit)
 from fruitimpact.signals.rebounds.measured import (EXPECTED_RATIO, EXPECTED_RATIO_SD, HELD_FRUIT_SHARE,
                                                    LOT_RESTITUTION_SD, QUIET_LANE_FRUIT, claimed_parent,
                                                    expected_rebound, held_alternative, hidden_rebound, judge,
                                                    likeliest_hidden, reassigned, rebound_pulse, rebounds_due,
                                                    without_held)
-from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, RAW_SD, TOLERANCES, PulseSummary, Verdict,
-                                                 flight_time, from_indices, landing_speed, refine, shape_table)
+from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, DAMPING_EXPONENT, NEW_FRUIT, RAW_SD, TOLERANCES,
+                                                 PulseSummary, Verdict, flight_time, from_indices, landing_speed,
+                                                 rebound_x, refine, shape_table)
 
-__all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
+__all__ = ["AMBIGUOUS", "CHI2_3_99", "DAMPING_EXPONENT", "rebound_x", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
            "HELD_FRUIT_SHARE", "HIDDEN_FRUIT_MIN", "HIDDEN_SCORE_MAX", "NEW_FRUIT_EXCLUDED", "held_alternative",
            "impulse_distance", "reassigned", "without_held",
            "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
            "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
            "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",
            "flight_time", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
-           "landing_speed", "likeliest_hidden",
+           "landing_speed", "likeliest_hidden", "median_of", "robust_sd",
            "rebound_of_a_rebound", "rebound_pulse", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
            "too_light_for_fruit", "unmeasured_fruit"]

@@ -27,12 +27,12 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
 
     def median_and_sd(values):
         logs = np.log(values)
-        return float(np.exp(_median(logs))), _robust_sd(logs)
+        return float(np.exp(median_of(logs))), robust_sd(logs)
 
     peak, peak_sd = median_and_sd([f.peak_force for f in fruit])
     tc, tc_sd = median_and_sd([f.time_to_peak for f in fruit])
     x, x_sd = lane.x, lane.x_sd
-    duration = float(_median([f.separation - f.onset for f in fruit]))
+    duration = float(median_of([f.separation - f.onset for f in fruit]))
     # a lot's own spread, which three fruit cannot measure: Hertz, F_max ∝ m^0.6 K^0.4 and t_c ∝ m^0.4 K^-0.4
     # at one speed, with the mass spread of the impulse and the stiffness spread of a lot
     peak_floor = math.hypot(0.6 * LOT_IMPULSE_SD, 0.4 * LOT_STIFFNESS_SD)
@@ -114,7 +114,7 @@ def restitution_floor(count: int) -> float:
     return LOT_RESTITUTION_SD if count >= LANE_FRUIT_MIN else FEW_FRUIT_RESTITUTION_SD
 
 
-def _median(values) -> float:
+def median_of(values) -> float:
     """``np.median`` of the few values a lane keeps (its fruit, or every lane's), to the bit, without NumPy's per-call
     overhead (~35 µs: the rebound tests take a dozen medians per contact, 15 % of a busy line's analysis).  NaN
     when empty or when any value is NaN, as NumPy."""
@@ -126,10 +126,10 @@ def _median(values) -> float:
     return ordered[middle] if n % 2 else (ordered[middle - 1] + ordered[middle]) / 2.0
 
 
-def _robust_sd(values) -> float:
+def robust_sd(values) -> float:
     values = [float(v) for v in values]
-    center = _median(values)
-    return 1.4826 * _median([abs(v - center) for v in values])
+    center = median_of(values)
+    return 1.4826 * median_of([abs(v - center) for v in values])
 
 
 @dataclass(frozen=True)
@@ -151,8 +151,8 @@ def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
     log_impulse = np.log([f.impulse for f in fruit])
     restitution = [f.restitution for f in fruit]
     log_x = np.log([max(f.x, 1e-6) for f in fruit])
-    return LaneFruit(float(np.exp(_median(log_impulse))), _robust_sd(log_impulse), float(_median(restitution)),
-                     _robust_sd(restitution), float(np.exp(_median(log_x))), _robust_sd(log_x))
+    return LaneFruit(float(np.exp(median_of(log_impulse))), robust_sd(log_impulse), float(median_of(restitution)),
+                     robust_sd(restitution), float(np.exp(median_of(log_x))), robust_sd(log_x))
 
 
 #: Least spread (sd of ln) of the impulse of a lane's fruit that ``landed_with_rebound`` assumes: fruit of one
@@ -369,7 +369,7 @@ def _as_lane_rebound(candidate: PulseSummary, fruit: list[PulseSummary], lane: L
     e_sd = math.hypot(abs(de_dlnx) * math.hypot(x_sd, r_sd), candidate.restitution_sd)
     impulse_pred = impulse_lane * r * (1.0 + e_pred) / (1.0 + e_lane)
     log_k = [_log_stiffness(f, velocity)[0] for f in fruit]
-    k_lane, k_sd = float(_median(log_k)), max(_robust_sd(log_k), LOT_STIFFNESS_SD)
+    k_lane, k_sd = float(median_of(log_k)), max(robust_sd(log_k), LOT_STIFFNESS_SD)
     k_rebound, k_meas = _log_stiffness(candidate, r * velocity)
     k_fruit = _log_stiffness(candidate, velocity)[0]  # the same pulse read as a fruit at the line's speed
     deviations = {
@@ -423,7 +423,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     tol = TOLERANCES
     z = tol["z"]
     lane = lane_fruit(fruit)
-    duration = float(_median([f.separation - f.onset for f in fruit]))
+    duration = float(median_of([f.separation - f.onset for f in fruit]))
     shared = _as_lane_rebound(candidate, fruit, lane, velocity, EXPECTED_RATIO * lane.restitution)
     r, r_sd = shared["r"], shared["r_sd"]
     flight_pred = flight_time(r * velocity)

@@ -8,15 +8,17 @@ import math
 from dataclasses import replace
 
 from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, NEW_FRUIT, TOLERANCES, PulseSummary, Verdict, _at,
-                                                 flight_time)
+                                                 flight_time, rebound_x)
 
 
 def _speed_ratio(candidate: PulseSummary, parent: PulseSummary) -> float:
-    """r solving I_j/I_p = r (1 + e(r x_p))/(1 + e_p) (a few fixed-point steps: the e term moves slowly)."""
+    """r solving I_j/I_p = r (1 + e(x_r))/(1 + e_p), x_r = ``rebound_x`` (a few fixed-point steps: the e term moves
+    slowly)."""
     ratio = candidate.impulse / parent.impulse
     r = ratio
     for _ in range(8):
-        r = ratio * (1.0 + parent.restitution) / (1.0 + _at("e", r * parent.x))
+        r = ratio * (1.0 + parent.restitution) / (1.0 + _at("e", rebound_x(candidate.x, parent.x, r,
+                                                                          candidate.damping_exponent)))
     return r
 
 
@@ -24,7 +26,7 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
     """Deviations (in tolerances) of "candidate is parent's rebound", and what they compare."""
     tol = TOLERANCES
     r = _speed_ratio(candidate, parent)
-    xr = r * parent.x
+    xr = rebound_x(candidate.x, parent.x, r, candidate.damping_exponent)
     peak_pred = parent.peak_force * r ** 1.2 * _at("P", xr) / _at("P", parent.x)
     tc_pred = parent.time_to_peak * r ** -0.2 * _at("tc", xr) / _at("tc", parent.x)
     r_sd = math.hypot(candidate.impulse_sd, parent.impulse_sd)
@@ -39,8 +41,11 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
         "time_to_peak": abs(math.log(candidate.time_to_peak / tc_pred))
         / (z * math.sqrt(candidate.time_to_peak_sd ** 2 + parent.time_to_peak_sd ** 2 + tol["spot"] ** 2)),
         "shape": abs(candidate.x - xr)
-        / (z * math.sqrt(candidate.x_sd ** 2 + (r * parent.x_sd) ** 2 + (tol["shape"] * xr) ** 2) + 1e-12),
+        / (z * math.sqrt(candidate.x_sd ** 2 + (xr / parent.x * parent.x_sd if parent.x > 0 else parent.x_sd) ** 2
+                         + (tol["shape"] * xr) ** 2) + 1e-12),
     }
+    if r * (1.0 - z * r_sd) > 1.0:  # faster than its parent's own impact beyond the impulses' error: no rebound
+        deviations["speed_ratio"] = math.inf  # (energy), however uncertain the parent's e
     flight = candidate.onset - parent.separation
     evidence = {"parent": parent.sequence, **({"virtual_parent": True} if parent.virtual else {}),
                 "flight_observed": flight, "flight_predicted": None,

@@ -28,6 +28,21 @@ def landing_speed(flight: float) -> float:
 #: Tolerances of the tests (the package docstring): relative flight and speed ratio, the model part of the
 #: peak and time-to-peak comparison, the model part of the shape comparison, and the z multiple.
 TOLERANCES = {"flight": 0.25, "speed_ratio": 0.25, "speed_ratio_up": 0.10, "spot": 0.04, "shape": 0.10, "z": 3.0}
+#: How a rebound's x = c V follows from its parent's: x_r = r^β x_p, β in this range.  β = 1 when the damping c is
+#: a constant of the fruit (Hunt–Crossley: a slower impact is livelier); β = 0 when the restitution is
+#: (Lankarani–Nikravesh, Flores: c ∝ 1/V).  Fruit lie between (an apple's e falls with the drop height, by
+#: an amount that differs between studies), so a rebound is tested against the whole range.
+DAMPING_EXPONENT = (0.0, 1.0)
+
+
+def rebound_x(x: float, parent_x: float, ratio: float, exponent: tuple[float, float] = DAMPING_EXPONENT) -> float:
+    """The x = c V of a rebound at speed ratio ``ratio`` of a parent of x ``parent_x``, nearest ``x`` (the rebound's
+    own, measured) among those the damping laws allow: x_r = r^β x_p, β in ``exponent`` (``DAMPING_EXPONENT``, or
+    the line's own range once its rebounds have shown it: ``PulseSummary.damping_exponent``)."""
+    low, high = sorted((ratio ** exponent[1] * parent_x, ratio ** exponent[0] * parent_x))
+    return min(max(x, low), high)
+
+
 #: Scores in this band around 1 mark the decision ambiguous (kept, with the evidence).
 AMBIGUOUS = (0.8, 1.25)
 #: Relative measurement uncertainties of the raw indices (indices.py: F_max sd ≈ 0.3 %, t_c ≈ 0.7 %,
@@ -131,6 +146,9 @@ class PulseSummary:
     #: a new fruit, lasted, and was not seen: it may have landed with it, too close for a joint fit to tell apart
     #: (``measured.held_alternative``)
     held: tuple[float, float, int] | None = None
+    #: the range of β (x_r = r^β x_p, ``rebound_x``) this contact is judged with as a rebound: ``DAMPING_EXPONENT``
+    #: until the line's own rebounds have shown where its fruit lie (``LineAnalyzer.damping_exponent``)
+    damping_exponent: tuple[float, float] = DAMPING_EXPONENT
 
     def with_velocity(self, velocity: float | None, read: bool = False) -> PulseSummary:
         return replace(self, velocity=velocity, speed_read=bool(read and velocity is not None))
