@@ -158,8 +158,9 @@ def test_a_contact_faster_than_its_parent_is_no_rebound_however_uncertain_the_pa
     e_p V_p < V_p.  A slow contact (0.45 V, itself a rebound) whose restitution is poorly measured (sd 0.3, as a
     piece of an overlap's can be) and then a new fruit of the same kind at the line's speed, landing after the
     flight of a body leaving at V: r = 2.2, and the tolerance on r/e_p, widened by e_p's sd, had let it pass
-    (deviation 0.90; seen on a Flores line of tests/linegen.py at r = 1.75).  r beyond 1 by more than 3 × the
-    impulses' error rules it out."""
+    (deviation 0.90; seen on a Flores line of tests/linegen.py at r = 1.75).  The impulse ratio needs no e: a
+    rebound carries I_p r (1 + e_j)/(1 + e_p) ≤ 2 e_p/(1 + e_p) I_p < I_p, so a ratio beyond 1 by more than 3 ×
+    the impulses' error rules it out."""
     import dataclasses
 
     slow = impact(velocity=0.45 * V_LINE)

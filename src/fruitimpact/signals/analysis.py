@@ -567,14 +567,15 @@ class LineAnalyzer:
     def damping_exponent(self) -> tuple[float, float]:
         """The range of β (x_r = r^β x_p) the line's rebounds are judged with: ``rebounds.DAMPING_EXPONENT`` until
         ``DAMPING_MIN_REBOUNDS`` clear rebounds have shown the line's own, then the median of the last
-        ``DAMPING_KEPT`` ± max(3 robust sd/√n, ``DAMPING_HALF_WIDTH``), within ``DAMPING_EXPONENT``."""
+        ``DAMPING_KEPT`` (held within ``DAMPING_EXPONENT``) ± max(3 robust sd/√n, ``DAMPING_HALF_WIDTH``)."""
         count = len(self._exponents)
         if count < DAMPING_MIN_REBOUNDS:
             return DAMPING_EXPONENT
-        median = median_of(self._exponents)
+        # the median held inside the laws' range, so the range is never narrower than the half-width on its side;
+        # it is cut to the laws' range where a contact is judged (``rebounds.rebound_x``)
+        median = min(max(median_of(self._exponents), DAMPING_EXPONENT[0]), DAMPING_EXPONENT[1])
         half = max(3.0 * robust_sd(self._exponents) / math.sqrt(count), DAMPING_HALF_WIDTH)
-        low, high = max(median - half, DAMPING_EXPONENT[0]), min(median + half, DAMPING_EXPONENT[1])
-        return (low, high) if low < high else DAMPING_EXPONENT
+        return median - half, median + half
 
     def _judged(self, summary: PulseSummary) -> PulseSummary:
         """``summary`` with the range of β it is judged with as a rebound (``damping_exponent``)."""
@@ -586,7 +587,7 @@ class LineAnalyzer:
         """Keep the β a clear rebound of a measured contact shows, ln(x_r/x_p)/ln r (``damping_exponent``)."""
         ratio = verdict.speed_ratio
         if verdict.ambiguous or parent.virtual or not ratio or not 0.0 < ratio <= DAMPING_RATIO_MAX \
-                or not (rebound.x > 0 and parent.x > 0):
+                or not (rebound.refined and parent.refined and rebound.x > 0 and parent.x > 0):  # x of a shape fit
             return
         self._exponents.append(math.log(rebound.x / parent.x) / math.log(ratio))
         del self._exponents[:-DAMPING_KEPT]

@@ -2,8 +2,8 @@
 (issue 13, item 1), never by "smaller and soon".
 
 A fruit that leaves the plate at V₂ flies 2 V₂/g (no drag) and lands again as the *same* fruit: the
-same mass m, contact stiffness K and damping, at the lower speed.  For the force law F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale
-times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
+same mass m, contact stiffness K and damping, at the lower speed.  For the force law
+F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
 
     F_max = K δ_H^1.5 · P(x)/1.25,   t_c = t_H · τ_c(x),   T = t_H · τ_T(x),   ∫F dt = m V (1 + e(x)),
 
@@ -24,8 +24,8 @@ with a constant restitution, x_j = r x_p alone took 268 of their rebounds for ne
 
 The impulse ratio gives r (it does not depend on where the fruit lands on itself); the peak force, the
 time to peak and the shape x must then agree with it, r must be the restitution of p (r ≈ e_p: the fruit
-cannot come back faster, and spin or an off-axis bounce take a little), and, when p's impact speed is known (the line's drop height, or a fitted velocity), the
-observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
+cannot come back faster, and spin or an off-axis bounce take a little), and, when p's impact speed is known
+(the line's drop height, or a fitted velocity), the observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
 
 Each test gives a deviation in units of its tolerance; the score S of the hypothesis is the largest.
 Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
@@ -38,7 +38,9 @@ Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:
 * peak force and time to peak: 3 × √(σ_meas² + 4 %²), the 4 % for a rebound landing on another spot
   of the fruit (local radius and modulus ±10 % move F_max and t_c by ~4 %: both go as K^±0.4);
 * shape: the measured x_j against the nearest x the damping laws allow (``rebound_x``), within
-  3 × √(σ_j² + (x_j/x_p · σ_p)² + (0.1 x_j)²): 0 inside the range.
+  3 × √(σ_j² + (x_j/x_p · σ_p)² + (0.1 x_j)²): 0 inside the range;
+* energy: I_j/I_p ≤ 1 within 3 × the impulses' error (a rebound carries at most 2 e_p/(1 + e_p) < 1 of its
+  parent's impulse), beyond it no rebound whatever the other tests say.
 
 S ≤ 1: a rebound.  S > 1: a new fruit.  Near the boundary (``AMBIGUOUS`` band) the decision is kept but
 flagged ambiguous, with the evidence (predicted and observed flight and peak).  A known feed
@@ -79,13 +81,12 @@ from fruitimpact.signals.rebounds.pulses import (AMBIGUOUS, DAMPING_EXPONENT, NE
                                                  PulseSummary, Verdict, flight_time, from_indices, landing_speed,
                                                  rebound_x, refine, shape_table)
 
-__all__ = ["AMBIGUOUS", "CHI2_3_99", "DAMPING_EXPONENT", "rebound_x", "CHI2_4_99", "EXPECTED_RATIO", "EXPECTED_RATIO_SD", "FLIGHT_TOLERANCE_SD",
-           "HELD_FRUIT_SHARE", "HIDDEN_FRUIT_MIN", "HIDDEN_SCORE_MAX", "NEW_FRUIT_EXCLUDED", "held_alternative",
-           "impulse_distance", "reassigned", "without_held",
-           "LANE_FRUIT_MIN", "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT",
+__all__ = ["AMBIGUOUS", "CHI2_3_99", "CHI2_4_99", "DAMPING_EXPONENT", "EXPECTED_RATIO", "EXPECTED_RATIO_SD",
+           "FLIGHT_TOLERANCE_SD", "HELD_FRUIT_SHARE", "HIDDEN_FRUIT_MIN", "HIDDEN_SCORE_MAX", "LANE_FRUIT_MIN",
+           "LOT_IMPULSE_SD", "LOT_RESTITUTION_SD", "LOT_STIFFNESS_SD", "LaneFruit", "NEW_FRUIT", "NEW_FRUIT_EXCLUDED",
            "ORPHAN_MARGIN", "PAIR_DISTANCE_MAX", "PAIR_MARGIN", "PulseSummary", "QUIET_LANE_FRUIT", "RAW_SD",
-           "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "from_indices",
-           "flight_time", "hidden_rebound", "judge", "judge_unmeasured", "landed_with_rebound", "lane_fruit",
-           "landing_speed", "likeliest_hidden", "median_of", "robust_sd",
-           "rebound_of_a_rebound", "rebound_pulse", "rebounds_due", "rebounds_landed_together", "refine", "shape_table",
-           "too_light_for_fruit", "unmeasured_fruit"]
+           "SLOW_PARENT_RATIO", "TOLERANCES", "Verdict", "claimed_parent", "expected_rebound", "flight_time",
+           "from_indices", "held_alternative", "hidden_rebound", "impulse_distance", "judge", "judge_unmeasured",
+           "landed_with_rebound", "landing_speed", "lane_fruit", "likeliest_hidden", "median_of", "reassigned",
+           "rebound_of_a_rebound", "rebound_pulse", "rebound_x", "rebounds_due", "rebounds_landed_together", "refine",
+           "robust_sd", "shape_table", "too_light_for_fruit", "unmeasured_fruit", "without_held"]

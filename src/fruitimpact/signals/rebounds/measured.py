@@ -44,8 +44,8 @@ def _hypothesis(candidate: PulseSummary, parent: PulseSummary) -> dict:
         / (z * math.sqrt(candidate.x_sd ** 2 + (xr / parent.x * parent.x_sd if parent.x > 0 else parent.x_sd) ** 2
                          + (tol["shape"] * xr) ** 2) + 1e-12),
     }
-    if r * (1.0 - z * r_sd) > 1.0:  # faster than its parent's own impact beyond the impulses' error: no rebound
-        deviations["speed_ratio"] = math.inf  # (energy), however uncertain the parent's e
+    if candidate.impulse / parent.impulse > 1.0 + z * r_sd:  # energy: a rebound carries I_p r (1 + e_j)/(1 + e_p)
+        deviations["speed_ratio"] = math.inf  # ≤ I_p 2 e_p/(1 + e_p) < I_p, whatever e_p (no estimate of e needed)
     flight = candidate.onset - parent.separation
     evidence = {"parent": parent.sequence, **({"virtual_parent": True} if parent.virtual else {}),
                 "flight_observed": flight, "flight_predicted": None,
@@ -148,7 +148,7 @@ def reassigned(candidate: PulseSummary, earlier: list[PulseSummary], threshold: 
             if other is taken or other is claimant or other.rebound_taken or not other.onset < claimant.onset \
                     or claimant.onset - other.separation > max_flight:
                 continue
-            theirs = _hypothesis(claimant, other)
+            theirs = _hypothesis(replace(claimant, damping_exponent=candidate.damping_exponent), other)  # the range now
             if theirs["score"] <= threshold:
                 options.append((max(mine["score"], theirs["score"]), mine, theirs, claimant))
     if not options:
@@ -265,7 +265,8 @@ EXPECTED_RATIO, EXPECTED_RATIO_SD = 0.92, 0.10
 
 def expected_rebound(parent: PulseSummary) -> dict:
     """The pulse that ``parent``'s rebound should be, as priors for a joint fit (``split.split_contact``):
-    the same fruit (m, K, c) at r V_p, so with x_r = r x_p
+    the same fruit (m, K, c) at r V_p, so with x_r = r x_p (Hunt–Crossley's constant c: a prediction takes one
+    law; a rebound measured later is judged under the line's range, ``pulses.rebound_x``)
 
         ln F_r = ln F_p + 1.2 ln r + ln P(x_r)/P(x_p),   ln T_r = ln T_p − 0.2 ln r + ln τ_T(x_r)/τ_T(x_p),
 

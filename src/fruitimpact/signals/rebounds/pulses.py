@@ -39,7 +39,9 @@ def rebound_x(x: float, parent_x: float, ratio: float, exponent: tuple[float, fl
     """The x = c V of a rebound at speed ratio ``ratio`` of a parent of x ``parent_x``, nearest ``x`` (the rebound's
     own, measured) among those the damping laws allow: x_r = r^β x_p, β in ``exponent`` (``DAMPING_EXPONENT``, or
     the line's own range once its rebounds have shown it: ``PulseSummary.damping_exponent``)."""
-    low, high = sorted((ratio ** exponent[1] * parent_x, ratio ** exponent[0] * parent_x))
+    # within the laws' range whatever the line's range reaches (it is centred on the line's β)
+    first, last = max(exponent[0], DAMPING_EXPONENT[0]), min(exponent[1], DAMPING_EXPONENT[1])
+    low, high = sorted((ratio ** last * parent_x, ratio ** first * parent_x))
     return min(max(x, low), high)
 
 
