@@ -54,7 +54,7 @@ TEXT = {"model": None, "calibration": None, "method": ("accurate",), "criterion"
 #: Damage inputs reported as used (``ImpactResult.damage_inputs``), as the table path names them.
 _DAMAGE_INPUTS = ("yield_pressure", "surface_thickness", "partner_mass", "failure_stress", "bruise_susceptibility")
 _DAMPED = ("restitution", "alpha", "damping")
-#: The damage outputs of an elastic impact judged by no criterion (``impact.evaluation._damage_columns``).
+#: The damage outputs of an elastic impact judged by no criterion (``impact.bruising.damage_columns``).
 _NO_CRITERION = {"yield_velocity": math.inf, "permanent_deflection": 0.0, "plastic_work": 0.0, "viscous_work": None,
                  "fruit_energy": None, "max_shear_stress": None, "bruise_margin": math.nan, "bruised": None,
                  "bruise_volume": math.nan, "bruise_depth": math.nan, "bruise_width": math.nan}

@@ -27,7 +27,7 @@ class Impacts:
 def _impacts(fruit: str, tests: Tests) -> Impacts:
     """Every test's impact, in one ``impact.evaluation.evaluation`` of the table: the energy criterion with the
     threshold set to the test's own impact energy E on the impact basis, so that 1 + bruise_margin is the share
-    of E the simulator compares (its own code path: ``_damage_columns``' ``impact_share``)."""
+    of E the simulator compares (its own code path: ``impact.bruising.damage_columns``' ``impact_share``)."""
     from fruitimpact.impact.evaluation import evaluation
     from fruitimpact.impact.status import INACCURATE
 
