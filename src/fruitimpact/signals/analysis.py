@@ -443,11 +443,11 @@ class LineAnalyzer:
             # can be expected (``rebounds_due``) and its flight tested; the fit still leaves its m and K unsplit
             kept = summary.with_velocity(landing, False) if speed is None and is_finite_number(landing) \
                 else summary.with_velocity(speed, read)
-            if not rebound and status == "ok" and orphan is None and due:
-                # a new fruit while a rebound was due in it: that rebound may have landed with it, too close to
-                # tell apart, and then the fruit's own rebound is judged against the fruit alone as well
-                # (``rebounds.held_alternative``)
-                held = likeliest_hidden(list(due), report["start_time"])
+            if not rebound and status == "ok" and orphan is None and (due or hidden_due):
+                # a new fruit while a rebound was due in it (a measured contact's, or a fruit's hidden in an earlier
+                # overlap): that rebound may have landed with it, too close to tell apart, and then the fruit's own
+                # rebound is judged against the fruit alone as well (``rebounds.held_alternative``)
+                held = likeliest_hidden([*due, *hidden_due], report["start_time"])
                 if held is not None:
                     pulse = hidden_rebound(held, sequence, report["start_time"])
                     kept = dataclasses.replace(kept, held=(pulse.impulse, pulse.peak_force, held.sequence))
