@@ -421,7 +421,8 @@ def test_a_fruit_and_two_rebounds_within_ten_milliseconds(cli, tmp_path):
 @pytest.mark.parametrize("name, seed, onset", [("chain10", 28, 0.62402), ("chain10", 8, 1.56479),
                                                ("chain10", 27, 3.81254),
                                                ("chain7", 26, 0.72130), ("chain10", 7, 2.49546),
-                                               ("chain10", 36, 2.66313), ("lanes4", 6, 1.05291)])
+                                               ("chain10", 36, 2.66313), ("lanes4", 6, 1.05291),
+                                               ("grades", 9, 15.50611), ("grades", 18, 7.89466)])
 def test_a_rebound_whose_parent_was_misread_is_still_a_rebound(cli, tmp_path, name, seed, onset):
     """Rebounds of the independent generator that had been graded as new fruit, each for a reason of its
     own (seen with ``benchmarks/scorecard.py --seeds 25-32``):
@@ -446,7 +447,11 @@ def test_a_rebound_whose_parent_was_misread_is_still_a_rebound(cli, tmp_path, na
     * lanes4, seed 6, 1.053 s: its fruit landed 0.5 ms after the rebound of a fruit hidden in an earlier overlap and
       was read as one fruit carrying both impulses (1.6 times the lane's, 2.2 sd of a lane of four fruit: not
       flagged).  The fruit's own rebound is now judged against the fruit alone as well when the rebound due in it
-      was a hidden fruit's, as it already was for a measured contact's (``rebounds.held_alternative``).
+      was a hidden fruit's, as it already was for a measured contact's (``rebounds.held_alternative``);
+    * grades, seed 9, 15.506 s, and seed 18, 7.895 s: a fruit, a rebound and a second fruit 7-12 ms later in one
+      15-18 ms overlap that could not be split; the overlap kept one hidden fruit's slot, the first fruit's rebound
+      took it, and the second's had none.  An overlap that carries two fruit's impulse beyond the rebound due in it
+      and lasts 1.5 fruit contacts now keeps a slot for each (``LineAnalyzer._second_hidden_fruit``).
 
     Each is a rebound (all but chain10 at seed 7 were graded as fruit before), and the recording's scorecard takes
     no fruit for a rebound."""

@@ -509,6 +509,38 @@ def test_the_rebound_of_a_fruit_hidden_in_an_overlap_is_judged_against_the_lanes
     assert not late.rebound, late.evidence
 
 
+def test_an_overlap_carrying_two_fruit_keeps_a_slot_for_each():
+    """Impulse is conserved through a contact: an overlap that could not be split carries the sum of its pulses'
+    impulses, each fruit m (1 + e) V of the lane's.  One carrying two fruit's impulse beyond the rebound due in it,
+    over more than 1.5 fruit contacts, hides a second fruit, which landed last: it ended with the overlap, so it
+    landed one fruit contact before the overlap's end.  One fruit and a rebound (1.6 fruit's impulse), or one
+    fruit's impulse over a long contact, hide one (analysis.LineAnalyzer._second_hidden_fruit)."""
+    import dataclasses
+
+    from fruitimpact.signals.analysis import TWO_FRUIT_DURATION, TWO_FRUIT_IMPULSE
+    from fruitimpact.signals.rebounds import hidden_rebound, median_of
+
+    analyzer = Analysis(RATE, fit=True, velocity=V_LINE).analyzer()
+    fruit = _lane_fruit(8)
+    analyzer._fruit = {0: fruit}
+    impulse = median_of([f.impulse for f in fruit])
+    duration = median_of([f.separation - f.onset for f in fruit])
+    two = {"start_time": 2.0, "impulse": 2.0 * impulse, "contact_duration": 2.4 * duration}
+    assert analyzer._second_hidden_fruit(0, two, []) == pytest.approx(2.0 + 1.4 * duration)
+    fruit_and_rebound = {**two, "impulse": 1.6 * impulse}
+    assert analyzer._second_hidden_fruit(0, fruit_and_rebound, []) is None
+    assert 1.6 < TWO_FRUIT_IMPULSE < 2.0 and TWO_FRUIT_DURATION <= 2.4
+    close = {**two, "contact_duration": 1.2 * duration}  # two fruit landing together: one pulse, one slot
+    assert analyzer._second_hidden_fruit(0, close, []) is None
+    # a rebound due in it is taken out first: a fruit, its neighbour's rebound and another fruit's 0.3 of impulse
+    parent = fruit[3]
+    rebound = hidden_rebound(parent, -1, 2.0).impulse
+    due_parent = dataclasses.replace(parent, onset=2.0 - 0.2, separation=2.0 - 0.2 + duration)
+    held = {**two, "impulse": 1.3 * impulse + rebound}
+    assert analyzer._second_hidden_fruit(0, held, [due_parent]) is None
+    assert analyzer._second_hidden_fruit(0, {**held, "impulse": 2.0 * impulse + rebound}, [due_parent]) is not None
+
+
 def test_a_lane_with_few_measured_fruit_is_judged_by_the_fruit_of_every_lane():
     """One lot on one line at the one speed the analysis is given: until a lane has measured LANE_FRUIT_MIN fruit
     of its own (a lane just started, or one whose first fruit were hidden in overlaps), the fruit a hidden fruit

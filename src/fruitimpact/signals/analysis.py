@@ -75,6 +75,13 @@ HOLDS_TWO = "_holds_two"
 FITS_AGAIN = 2
 #: Measured new fruit kept per lane: they stand for a fruit hidden in an overlap (``rebounds.judge_unmeasured``).
 LANE_FRUIT_KEPT = 15
+#: An overlap that could not be split hides two fruit, not one, when what it carries beyond the rebound due in it
+#: is at least this many times a fruit of the lane (each fruit m (1 + e) V: one fruit is 1 ± 0.15 of the lane's,
+#: two 2 ± 0.2, so 1.75 lies 3.7 sd above one and 0.9 sd below two) and it lasts at least ``TWO_FRUIT_DURATION``
+#: times a fruit's contact (two fruit landing apart).  Seen on tests/linegen.py's grades (seeds 9, 10, 18): a
+#: fruit, a rebound and a second fruit 12 ms later in one 15-18 ms overlap, whose second fruit's rebound, with no
+#: slot left for it, was graded as a new fruit.
+TWO_FRUIT_IMPULSE, TWO_FRUIT_DURATION = 1.75, 1.5
 #: A lane's impact speed read from its own rebounds when it is not given (``LineAnalyzer.line_speed``): each
 #: clear first rebound of a new fruit flew 2 r V/g (r its speed ratio, measured from the two pulses), so
 #: V = g · flight / (2 r).  It is used once ``SPEED_MIN_REBOUNDS`` of the lane's agree: their median, from the
@@ -123,6 +130,8 @@ class LineAnalyzer:
         #: (lane, sequence) of the overlaps whose hidden fruit's slot one contact has claimed without naming it its
         #: parent (``rebounds.judge_unmeasured``, ``new_fruit_excluded``): the next claim closes it
         self._claimed_once: set[tuple[int, int]] = set()
+        #: the hidden fruit's slot (sequence, onset, end) the last ``_unmeasured_parent`` verdict was judged against
+        self._slot_claimed: tuple | None = None
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
@@ -400,8 +409,11 @@ class LineAnalyzer:
             key = (impact.lane, chosen.parent)
             if chosen.evidence.get("new_fruit_excluded") and key not in self._claimed_once:
                 self._claimed_once.add(key)
-            else:
-                self._unmeasured[impact.lane] = [u for u in self._unmeasured[impact.lane] if u[0] != chosen.parent]
+            else:  # the slot it was judged against (an overlap may hide two fruit: the other's stays)
+                slots = self._unmeasured[impact.lane]
+                claimed = self._slot_claimed if self._slot_claimed in slots else \
+                    next(u for u in slots if u[0] == chosen.parent)
+                slots.remove(claimed)
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
             landing = landing_speed(chosen.evidence["flight_observed"])
         elif rebound and slow_parent:  # its parent was a rebound taken for a fruit: no longer one of the lane's fruit
@@ -474,6 +486,9 @@ class LineAnalyzer:
         elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
+            second = self._second_hidden_fruit(impact.lane, report, [] if piece or together is not None else due)
+            if second is not None:  # the last of two hidden fruit ended with the overlap
+                self._unmeasured[impact.lane].append((sequence, second, span_end))
             if together is not None:  # the rebounds it holds are seen here (once), their bounces expected from here
                 for parent in together_parents:
                     if any(parent is hidden for hidden in hidden_due):  # a fruit hidden in an earlier overlap
@@ -621,10 +636,31 @@ class LineAnalyzer:
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
         fruit = self._lane_fruit(lane)
-        verdicts = [judge_unmeasured(summary, sequence, onset, fruit, self.line_speed(lane))
-                    for sequence, onset, _ in reversed(recent)]
-        return min(verdicts, key=lambda v: v.evidence["score"] if v.evidence and v.evidence["score"] is not None
-                   else math.inf, default=NEW_FRUIT)
+        judged = [(judge_unmeasured(summary, sequence, onset, fruit, self.line_speed(lane)), (sequence, onset, end))
+                  for sequence, onset, end in reversed(recent)]
+        verdict, self._slot_claimed = min(judged, key=lambda pair: pair[0].evidence["score"] if pair[0].evidence
+                                          and pair[0].evidence["score"] is not None else math.inf,
+                                          default=(NEW_FRUIT, None))
+        return verdict
+
+    def _second_hidden_fruit(self, lane: int, report: dict, due: list[PulseSummary]) -> float | None:
+        """The onset [s] of a second fruit hidden in an overlap that could not be split (``report``: the contact
+        as detected, its impulse summed over it), or None: when it carries, beyond the rebound due in it (the
+        likeliest of ``due``, as ``hidden_rebound`` predicts it), ``TWO_FRUIT_IMPULSE`` times the impulse of the
+        lane's fruit (their median, with at least ``LANE_FRUIT_MIN`` of them) and lasts ``TWO_FRUIT_DURATION``
+        times their contact.  The second fruit landed last, so its contact ends with the overlap's: it landed a
+        fruit's contact duration before that."""
+        fruit = self._lane_fruit(lane)
+        impulse, duration = report.get("impulse"), report.get("contact_duration")
+        if len(fruit) < LANE_FRUIT_MIN or not (is_finite_number(impulse) and is_finite_number(duration)):
+            return None
+        held = likeliest_hidden(list(due), report["start_time"])
+        carried = impulse - (hidden_rebound(held, -1, report["start_time"]).impulse if held is not None else 0.0)
+        fruit_impulse = median_of([f.impulse for f in fruit])
+        fruit_duration = median_of([f.separation - f.onset for f in fruit])
+        if carried < TWO_FRUIT_IMPULSE * fruit_impulse or duration < TWO_FRUIT_DURATION * fruit_duration:
+            return None
+        return report["start_time"] + duration - fruit_duration
 
 
 #: Rate [Hz] of the warm-up's synthetic contacts.  What it prepares (the pulse tables, numba's compiled code) is
