@@ -448,7 +448,7 @@ def test_a_rebound_whose_parent_was_misread_is_still_a_rebound(cli, tmp_path, na
       was read as one fruit carrying both impulses (1.6 times the lane's, 2.2 sd of a lane of four fruit: not
       flagged).  The fruit's own rebound is now judged against the fruit alone as well when the rebound due in it
       was a hidden fruit's, as it already was for a measured contact's (``rebounds.held_alternative``);
-    * grades, seed 9, 15.506 s, and seed 18, 7.895 s: a fruit, a rebound and a second fruit 7-12 ms later in one
+    * grades, seed 9, 15.506 s, and seed 18, 7.895 s: a fruit, a rebound and a second fruit 10-12 ms later in one
       15-18 ms overlap that could not be split; the overlap kept one hidden fruit's slot, the first fruit's rebound
       took it, and the second's had none.  An overlap that carries two fruit's impulse beyond the rebound due in it
       and lasts 1.5 fruit contacts now keeps a slot for each (``LineAnalyzer._second_hidden_fruit``).
