@@ -133,7 +133,8 @@ def test_stream_equals_analyze_where_a_rebound_is_read_a_second_time(cli, tmp_pa
     ``rebounds.held_alternative``: a parent read as a fruit alone) change the analysis's books after a contact has
     been reported.  On recordings of the independent generator (tests/linegen.py, chain10 at seeds 8 and 27) where
     each fires (seed 28, where the re-reading was first seen, is judged right without it since a rebound's damping
-    may follow either law, ``rebounds.rebound_x``), ``stream`` fed through a pipe in random pieces writes the same objects as ``analyze``."""
+    may follow either law, ``rebounds.rebound_x``), ``stream`` fed through a pipe in random pieces writes the same
+    objects as ``analyze``."""
     import dataclasses
 
     import linegen as lg

@@ -42,7 +42,7 @@ from fruitimpact.signals.indices import impact_indices, second_pulse
 from fruitimpact.signals.rebounds import (DAMPING_EXPONENT, HIDDEN_FRUIT_MIN, LANE_FRUIT_MIN, NEW_FRUIT,
                                          QUIET_LANE_FRUIT, PulseSummary, Verdict, claimed_parent, expected_rebound,
                                          from_indices, hidden_rebound, judge, judge_unmeasured, landed_with_rebound,
-                                         landing_speed, likeliest_hidden, median_of, rebound_of_a_rebound,
+                                         landing_speed, lane_fruit, likeliest_hidden, median_of, rebound_of_a_rebound,
                                          rebounds_due, rebounds_landed_together, refine, robust_sd, shape_table,
                                          too_light_for_fruit, unmeasured_fruit)
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
@@ -130,8 +130,6 @@ class LineAnalyzer:
         #: (lane, sequence) of the overlaps whose hidden fruit's slot one contact has claimed without naming it its
         #: parent (``rebounds.judge_unmeasured``, ``new_fruit_excluded``): the next claim closes it
         self._claimed_once: set[tuple[int, int]] = set()
-        #: the hidden fruit's slot (sequence, onset, end) the last ``_unmeasured_parent`` verdict was judged against
-        self._slot_claimed: tuple | None = None
         _warm_up(analysis)  # tables built and compiled code loaded before the first fruit lands, not while it waits
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
@@ -344,13 +342,13 @@ class LineAnalyzer:
             verdict = judge(summary, history, max_flight=analysis.flight_limit,
                             last_fruit_onset=self._last_fruit(impact.lane), pitch=analysis.pitch,
                             quiet_fruit=self._quiet_fruit(impact.lane))
-        chosen, hidden_fruit = verdict, False
+        chosen, hidden_fruit, slot = verdict, False, None
         judged = verdict is not None and (verdict.rebound or verdict.ambiguous)
         if summary is not None and (not judged or verdict.ambiguous):
             # not clearly a measured (or predicted) contact's rebound: perhaps that of a fruit hidden in an overlap.
             # Where both hypotheses are near (a contact after an overlap that held a fruit and a rebound: the
             # rebound's own bounce, or the hidden fruit's), the closer one is kept
-            hidden = self._unmeasured_parent(impact.lane, summary)
+            hidden, slot = self._unmeasured_parent(impact.lane, summary)
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
@@ -410,10 +408,7 @@ class LineAnalyzer:
             if chosen.evidence.get("new_fruit_excluded") and key not in self._claimed_once:
                 self._claimed_once.add(key)
             else:  # the slot it was judged against (an overlap may hide two fruit: the other's stays)
-                slots = self._unmeasured[impact.lane]
-                claimed = self._slot_claimed if self._slot_claimed in slots else \
-                    next(u for u in slots if u[0] == chosen.parent)
-                slots.remove(claimed)
+                self._unmeasured[impact.lane].remove(slot)
             speed = None  # the hidden fruit's speed ratio is not measured: the fit leaves m and K unsplit
             landing = landing_speed(chosen.evidence["flight_observed"])
         elif rebound and slow_parent:  # its parent was a rebound taken for a fruit: no longer one of the lane's fruit
@@ -486,6 +481,8 @@ class LineAnalyzer:
         elif status == "overlap":
             span_end = report["start_time"] + report["contact_duration"]
             self._unmeasured.setdefault(impact.lane, []).append((sequence, report["start_time"], span_end))
+            # the rebound due in it is taken out of its impulse; a piece's pieces before it may have taken theirs,
+            # and a fruit landed with a rebound is one pulse (too short to be two fruit), so for those: none
             second = self._second_hidden_fruit(impact.lane, report, [] if piece or together is not None else due)
             if second is not None:  # the last of two hidden fruit ended with the overlap
                 self._unmeasured[impact.lane].append((sequence, second, span_end))
@@ -628,20 +625,19 @@ class LineAnalyzer:
                   for sequence, onset, _ in self._unmeasured.get(lane, []) if onset < summary.onset]
         return rebounds_due(summary.onset, summary.separation, hidden, max_flight=self.analysis.flight_limit)
 
-    def _unmeasured_parent(self, lane: int, summary: PulseSummary) -> Verdict:
+    def _unmeasured_parent(self, lane: int, summary: PulseSummary) -> tuple[Verdict, tuple | None]:
         """The verdict on a contact that no measured contact claims as its rebound: the rebound of a fruit hidden
-        in an earlier overlap of the lane (``rebounds.judge_unmeasured``), or a new fruit.  The caller removes the
-        overlap's entry when it takes the verdict (a hidden fruit rebounds once)."""
+        in an earlier overlap of the lane (``rebounds.judge_unmeasured``), or a new fruit; and the hidden fruit's
+        slot (sequence, onset, end) it was judged against (None with no slot).  The caller removes that slot when it
+        takes the verdict (a hidden fruit rebounds once)."""
         limit = self.analysis.flight_limit
         recent = [u for u in self._unmeasured.get(lane, []) if 0 < summary.onset - u[2] <= limit]
         self._unmeasured[lane] = [u for u in self._unmeasured.get(lane, []) if summary.onset - u[2] <= limit]
         fruit = self._lane_fruit(lane)
         judged = [(judge_unmeasured(summary, sequence, onset, fruit, self.line_speed(lane)), (sequence, onset, end))
                   for sequence, onset, end in reversed(recent)]
-        verdict, self._slot_claimed = min(judged, key=lambda pair: pair[0].evidence["score"] if pair[0].evidence
-                                          and pair[0].evidence["score"] is not None else math.inf,
-                                          default=(NEW_FRUIT, None))
-        return verdict
+        return min(judged, key=lambda pair: pair[0].evidence["score"] if pair[0].evidence
+                   and pair[0].evidence["score"] is not None else math.inf, default=(NEW_FRUIT, None))
 
     def _second_hidden_fruit(self, lane: int, report: dict, due: list[PulseSummary]) -> float | None:
         """The onset [s] of a second fruit hidden in an overlap that could not be split (``report``: the contact
@@ -656,11 +652,10 @@ class LineAnalyzer:
             return None
         held = likeliest_hidden(list(due), report["start_time"])
         carried = impulse - (hidden_rebound(held, -1, report["start_time"]).impulse if held is not None else 0.0)
-        fruit_impulse = median_of([f.impulse for f in fruit])
-        fruit_duration = median_of([f.separation - f.onset for f in fruit])
-        if carried < TWO_FRUIT_IMPULSE * fruit_impulse or duration < TWO_FRUIT_DURATION * fruit_duration:
+        lane = lane_fruit(fruit)
+        if carried < TWO_FRUIT_IMPULSE * lane.impulse or duration < TWO_FRUIT_DURATION * lane.duration:
             return None
-        return report["start_time"] + duration - fruit_duration
+        return report["start_time"] + duration - lane.duration
 
 
 #: Rate [Hz] of the warm-up's synthetic contacts.  What it prepares (the pulse tables, numba's compiled code) is

@@ -2,8 +2,9 @@
 (issue 13, item 1), never by "smaller and soon".
 
 A fruit that leaves the plate at V₂ flies 2 V₂/g (no drag) and lands again as the *same* fruit: the
-same mass m, contact stiffness K and damping, at the lower speed.  For the force law
-F = K δ^1.5 (1 + c δ̇) of the simulator every characteristic is a Hertz scale times a function of x = c V alone (``engine.powerlaw``; δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
+same mass m, contact stiffness K and damping, at the lower speed.  For the force law F = K δ^1.5 (1 + c δ̇) of
+the simulator every characteristic is a Hertz scale times a function of x = c V alone (``engine.powerlaw``;
+δ_H = (1.25 m V²/K)^0.4, t_H = δ_H/V):
 
     F_max = K δ_H^1.5 · P(x)/1.25,   t_c = t_H · τ_c(x),   T = t_H · τ_T(x),   ∫F dt = m V (1 + e(x)),
 
@@ -25,7 +26,8 @@ with a constant restitution, x_j = r x_p alone took 268 of their rebounds for ne
 The impulse ratio gives r (it does not depend on where the fruit lands on itself); the peak force, the
 time to peak and the shape x must then agree with it, r must be the restitution of p (r ≈ e_p: the fruit
 cannot come back faster, and spin or an off-axis bounce take a little), and, when p's impact speed is known
-(the line's drop height, or a fitted velocity), the observed flight from p's separation to j's onset must be the predicted 2 r V_p/g.
+(the line's drop height, or a fitted velocity), the observed flight from p's separation to j's onset must be the
+predicted 2 r V_p/g.
 
 Each test gives a deviation in units of its tolerance; the score S of the hypothesis is the largest.
 Tolerances (``TOLERANCES``), each drawn from what the physics leaves uncertain:

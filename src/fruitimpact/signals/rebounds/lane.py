@@ -32,7 +32,7 @@ def unmeasured_fruit(fruit: list[PulseSummary], sequence: int, onset: float, vel
     peak, peak_sd = median_and_sd([f.peak_force for f in fruit])
     tc, tc_sd = median_and_sd([f.time_to_peak for f in fruit])
     x, x_sd = lane.x, lane.x_sd
-    duration = float(median_of([f.separation - f.onset for f in fruit]))
+    duration = lane.duration
     # a lot's own spread, which three fruit cannot measure: Hertz, F_max ∝ m^0.6 K^0.4 and t_c ∝ m^0.4 K^-0.4
     # at one speed, with the mass spread of the impulse and the stiffness spread of a lot
     peak_floor = math.hypot(0.6 * LOT_IMPULSE_SD, 0.4 * LOT_STIFFNESS_SD)
@@ -136,7 +136,7 @@ def robust_sd(values) -> float:
 class LaneFruit:
     """What a lane's measured new fruit say of the next one: the median ``impulse`` [N s] and the robust sd of its
     logarithm, the median ``restitution`` and its robust sd, the median shape ``x`` = c V and the robust sd of its
-    logarithm (each caller floors the spreads as its test needs)."""
+    logarithm (each caller floors the spreads as its test needs), and the median contact ``duration`` [s]."""
 
     impulse: float
     impulse_sd: float
@@ -144,6 +144,7 @@ class LaneFruit:
     restitution_sd: float
     x: float
     x_sd: float
+    duration: float
 
 
 def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
@@ -152,7 +153,8 @@ def lane_fruit(fruit: list[PulseSummary]) -> LaneFruit:
     restitution = [f.restitution for f in fruit]
     log_x = np.log([max(f.x, 1e-6) for f in fruit])
     return LaneFruit(float(np.exp(median_of(log_impulse))), robust_sd(log_impulse), float(median_of(restitution)),
-                     robust_sd(restitution), float(np.exp(median_of(log_x))), robust_sd(log_x))
+                     robust_sd(restitution), float(np.exp(median_of(log_x))), robust_sd(log_x),
+                     float(median_of([f.separation - f.onset for f in fruit])))
 
 
 #: Least spread (sd of ln) of the impulse of a lane's fruit that ``landed_with_rebound`` assumes: fruit of one
@@ -423,7 +425,7 @@ def judge_unmeasured(candidate: PulseSummary, hidden: int, hidden_onset: float, 
     tol = TOLERANCES
     z = tol["z"]
     lane = lane_fruit(fruit)
-    duration = float(median_of([f.separation - f.onset for f in fruit]))
+    duration = lane.duration
     shared = _as_lane_rebound(candidate, fruit, lane, velocity, EXPECTED_RATIO * lane.restitution)
     r, r_sd = shared["r"], shared["r_sd"]
     flight_pred = flight_time(r * velocity)
