@@ -168,11 +168,18 @@ def _start(t, y, model: PulseModel, weights) -> tuple[np.ndarray | None, str]:
 # ---------------------------------------------------------------------------------------------------------
 # From θ to the reported quantities
 
-def derived(theta, velocity, mass, diameter, poisson) -> np.ndarray:
-    """The quantities of ``_FIT_NAMES`` (in that order) from θ, through the exact engine."""
+def _dimensionless(x: float) -> np.ndarray:
+    """The exact engine's characteristics of the unit impact at x = c V (``derived``)."""
+    return powerlaw_single(1.0, STIFFNESS_SCALE, 1.5, max(x, 0.0), 1.0, 1.0)
+
+
+def derived(theta, velocity, mass, diameter, poisson, dimless=None) -> np.ndarray:
+    """The quantities of ``_FIT_NAMES`` (in that order) from θ, through the exact engine (``dimless``: its
+    characteristics at θ's x when already computed, ``_dimensionless``)."""
     t0, log_peak, log_duration, x = theta
     peak, duration = math.exp(log_peak), math.exp(log_duration)
-    dimless = powerlaw_single(1.0, STIFFNESS_SCALE, 1.5, max(x, 0.0), 1.0, 1.0)
+    if dimless is None:
+        dimless = _dimensionless(x)
     t_scale = duration / dimless[CONTACT_DURATION]  # t_H
     f_scale = peak * STIFFNESS_SCALE / dimless[PEAK_FORCE]  # K δ_H^1.5
     e = dimless[RESTITUTION]
@@ -197,6 +204,7 @@ def _derived_stderr(theta, covariance, args) -> np.ndarray:
     floor = np.array([1e-9 * math.exp(theta[2]), 1e-9, 1e-9, 1e-9])
     steps = np.maximum(1e-4 * sd, floor)
     columns = []
+    dimless = _dimensionless(theta[3])  # the same for the steps in t0, peak and duration
     for i in range(4):
         up, down = theta.copy(), theta.copy()
         up[i] += steps[i]
@@ -205,7 +213,8 @@ def _derived_stderr(theta, covariance, args) -> np.ndarray:
             down[3] = theta[3]
         if i == 3 and up[3] > X_MAX:
             up[3] = theta[3]
-        columns.append((derived(up, *args) - derived(down, *args)) / (up[i] - down[i]))
+        at = dimless if i < 3 else None
+        columns.append((derived(up, *args, at) - derived(down, *args, at)) / (up[i] - down[i]))
     g = np.column_stack(columns)
     variance = np.einsum("qi,ij,qj->q", g, covariance, g)
     return np.sqrt(np.maximum(variance, 0.0))

@@ -17,8 +17,11 @@ def _speed_ratio(candidate: PulseSummary, parent: PulseSummary) -> float:
     ratio = candidate.impulse / parent.impulse
     r = ratio
     for _ in range(8):
+        previous = r
         r = ratio * (1.0 + parent.restitution) / (1.0 + _at("e", rebound_x(candidate.x, parent.x, r,
                                                                           candidate.damping_exponent)))
+        if r == previous:  # a fixed point to the last bit: further steps return it unchanged
+            break
     return r
 
 
