@@ -155,7 +155,7 @@ class LineAnalyzer:
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
                            f"(one fruit: at most {MISFIT_LIMIT:.1%}): two fruit landing together; no firmness")
-        parts = None
+        parts = flags = None
         due = []
         if is_finite_number(report["start_time"]):
             onset = report["start_time"]
@@ -171,7 +171,7 @@ class LineAnalyzer:
             gain = _split_gain(shape, parts, own) if parts is not None else 0.0
             if gain < SPLIT_GAIN:
                 parts = None  # one pulse fits as well: one fruit
-            elif not any(self._rebounds(parts, impact.noise)):
+            elif not any(flags := self._rebounds(parts, impact.noise)):
                 # two pulses, but neither is the rebound that was due: landing within a fraction of a
                 # millisecond, their onsets and amplitudes trade off; one contact, no firmness, is the honest report
                 message = (f"two pulses in one contact ({gain:.2f} noise variances per sample better fitted as two) "
@@ -179,7 +179,7 @@ class LineAnalyzer:
                            f"together; no firmness")
                 status, parts = "overlap", None
         if parts is not None:
-            flags = self._rebounds(parts, impact.noise)
+            flags = flags if flags is not None else self._rebounds(parts, impact.noise)  # judged once per split
             further = self._split_further(parts, flags, due)
             if further is not parts:
                 parts, flags = further, self._rebounds(further, impact.noise)
