@@ -24,7 +24,9 @@ matrix and the share of fruit ≥ 5 % from a threshold that get the right class 
 
 ``--seeds A-B``: every scenario generated with each of those seeds instead of its own (other lines of the same
 kinds, at benchmark size), two at a time; one line per recording and the totals (recordings short of full recall,
-extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit reported as overlaps).
+extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit reported as overlaps; fruit graded
+through a rebound they carry, i.e. one pulse fitted through both, and how many of those say so with
+``rebound_ambiguous``; lone fruit flagged that way).
 ``--variants``: the same at other settings of the generator (``VARIANTS``: flights ±20 %, spin to 15 %, 10 kHz,
 twice the noise, 3 and 6 cm drops, a restitution that does not change with speed), at seeds 1,2 or ``--seeds``.
 
@@ -200,15 +202,24 @@ def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
         pairs = lg.match(reports, truth)["pairs"]
         card["lone_fruit_overlaps"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
                                           and r.get("status") == "overlap")
+        card["carried"], card["carried_flagged"] = _carried(reports, truth)
+        # fruit that landed alone flagged as perhaps carrying a rebound (the price of that flag)
+        card["lone_fruit_flagged"] = sum(1 for c, r in pairs if not c["is_rebound"] and r.get("status") == "ok"
+                                         and (r.get("rebound_evidence") or {}).get("ambiguous") is True
+                                         and not any(d["is_rebound"] and d["lane"] == c["lane"]
+                                                     and abs(d["start_time"] - c["start_time"]) < 3e-3
+                                                     for d in truth["contacts"]))
         return label, seed, card
 
-    keys = ("extra", "fruit_taken_for_rebounds", "rebounds_taken_for_fruit", "lone_fruit_overlaps")
+    keys = ("extra", "fruit_taken_for_rebounds", "rebounds_taken_for_fruit", "lone_fruit_overlaps", "carried",
+            "carried_flagged", "lone_fruit_flagged")
     totals = dict.fromkeys(keys, 0)
     short = 0
     t0 = time.perf_counter()
     width = max(10, *(len(label) + 2 for label, _, _ in jobs))
     print(f"{'scenario':<{width}}{'seed':>5}{'contacts':>10}{'recall':>9}{'extra':>7}{'fruit→reb':>11}"
-          f"{'reb→fruit':>11}{'lone fruit as overlap':>23}{'p95 ΔF/F':>10}{'med ΔK/K':>10}{'p95 ΔK/K':>10}")
+          f"{'reb→fruit':>11}{'lone fruit as overlap':>23}{'carrying (flagged)':>20}{'p95 ΔF/F':>10}{'med ΔK/K':>10}"
+          f"{'p95 ΔK/K':>10}")
     with ThreadPoolExecutor(2) as pool:
         for label, seed, card in pool.map(one, jobs):
             short += card["recall"] < 1.0
@@ -216,13 +227,32 @@ def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
                 totals[key] += card[key]
             print(f"{label:<{width}}{seed:>5}{card['contacts']:>10}{card['recall']:>9.1%}{card['extra']:>7}"
                   f"{card['fruit_taken_for_rebounds']:>11}{card['rebounds_taken_for_fruit']:>11}"
-                  f"{card['lone_fruit_overlaps']:>23}{card['peak_force_p95']:>10.2%}{card['stiffness_median']:>10.2%}"
+                  f"{card['lone_fruit_overlaps']:>23}{'{} ({})'.format(card['carried'], card['carried_flagged']):>20}"
+                  f"{card['peak_force_p95']:>10.2%}{card['stiffness_median']:>10.2%}"
                   f"{card['stiffness_p95']:>10.1%}", flush=True)
     print(f"{len(jobs)} recordings in {time.perf_counter() - t0:.0f} s ({machine()}): "
           f"{short} short of full recall; extra {totals['extra']}, fruit taken for rebounds "
           f"{totals['fruit_taken_for_rebounds']}, rebounds taken for fruit {totals['rebounds_taken_for_fruit']}, "
-          f"lone fruit as overlaps {totals['lone_fruit_overlaps']}")
+          f"lone fruit as overlaps {totals['lone_fruit_overlaps']}; fruit graded through a rebound they carry "
+          f"{totals['carried']} ({totals['carried_flagged']} of them flagged rebound_ambiguous), lone fruit so flagged "
+          f"{totals['lone_fruit_flagged']}")
     return 0
+
+
+def _carried(reports: list[dict], truth: dict) -> tuple[int, int]:
+    """(fruit graded through a rebound they carry, of them flagged): truth rebounds no report found whose start lies
+    inside a graded fruit's report of their lane (status ok, no rebound: one pulse fitted through both, issue 13
+    item 2), and of those the reports with ``rebound_ambiguous`` (said, not silent)."""
+    missed = [c for c in lg.match(reports, truth)["missed"] if c["is_rebound"]]
+    carried = flagged = 0
+    for c in missed:
+        holder = next((r for r in reports if r.get("lane") == c["lane_name"] and r.get("status") == "ok"
+                       and not r.get("rebound") and r["start_time"] - 2e-3 <= c["start_time"]
+                       <= r["start_time"] + (r.get("contact_duration") or 0.0)), None)
+        if holder is not None:
+            carried += 1
+            flagged += bool(holder.get("rebound_ambiguous"))
+    return carried, flagged
 
 
 def main(argv=None) -> int:
