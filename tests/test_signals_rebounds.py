@@ -1621,36 +1621,3 @@ def test_a_fruit_of_the_lot_landing_off_a_hidden_fruits_rebound_flight_is_not_ex
     for late in (0.6, 0.65, 0.7, 1.4):
         verdict = judge_unmeasured(summary(apple, left + late * flight, 99), 42, 1.0, fruit, V_LINE)
         assert not verdict.rebound, (late, verdict.evidence)
-
-
-def _public_reports(x) -> str:
-    """The JSON of the reports (NaN written as NaN: equal text is equal values to the last bit)."""
-    import json
-
-    return json.dumps([{k: v for k, v in r.items() if not k.startswith("_")} for r in _reports(x)], sort_keys=True,
-                      default=float)
-
-
-def test_two_starts_fitted_at_once_give_what_one_after_the_other_gives_and_survive_a_fork(monkeypatch):
-    """The joint fits of a split run two starts at once (signals.split._fits: the compiled fit releases the GIL, the
-    second start on a worker thread); each fit is deterministic and its result is used in the starts' order, so the
-    reports are those of fitting them one after the other, to the last bit.  A process forked after the worker
-    thread existed (a pool's thread does not survive a fork) makes its own and still answers."""
-    import multiprocessing
-
-    from fruitimpact.signals import split
-
-    _, x = _lane_then_fruit_with_rebound(0, gap=2e-3)  # a fruit landing 2 ms before a rebound: split
-    at_once = _public_reports(x)
-    assert "told apart by a joint fit" in at_once, at_once
-    assert split._POOL, "the worker thread was not used"
-
-    def one_after_another(ts, y, weights, starts):
-        for start in starts:
-            yield start, split._joint_fit(ts, y, weights, *start)
-
-    with monkeypatch.context() as patch:
-        patch.setattr(split, "_fits", one_after_another)
-        assert _public_reports(x) == at_once
-    with multiprocessing.get_context("fork").Pool(1) as pool:
-        assert pool.apply_async(_public_reports, (x,)).get(timeout=120) == at_once

@@ -37,8 +37,6 @@ them).  Otherwise the contact stays one report with status ``overlap`` (``analys
 from __future__ import annotations
 
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -153,9 +151,8 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
     weights = np.full(ts.shape, 1.0 / noise)
     args = (velocity if mass is None else None, mass, diameter, poisson)
     found = []
-    for (_, prior), fitted in _fits(ts, y, weights, _starts(ts, y, noise, _landmarks(y) if dip else None, expected,
-                                                             fits)):
-        fit = _separated(model, ts, y, noise, fitted, prior)
+    for theta, prior in _starts(ts, y, noise, _landmarks(y) if dip else None, expected, fits):
+        fit = _separated(model, ts, y, noise, weights, theta, args, t_ref, prior)
         if fit is None:
             continue
         found.append(fit)
@@ -203,44 +200,13 @@ def _implausibility(theta, restitution) -> float:
     return sum(max(0.0, restitution - RESTITUTION_SPREAD - restitution_of_x(float(x))) for x in theta[3::4])
 
 
-def _joint_fit(ts, y, weights, theta, prior):
-    """The compiled joint fit started at ``theta`` (``fit_pulse_sum``; it releases the GIL, so another start can
-    be fitted beside it on a second core)."""
+def _separated(model, ts, y, noise, weights, theta, args, t_ref, prior=None):
+    """(χ², misfit, θ, covariance, rms, iterations) of the joint fit started at ``theta`` when it is accepted
+    (module docstring), else None."""
     with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
-        return fit_pulse_sum(ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None
-                                                        else ()), max_iterations=SPLIT_ITERATIONS)
-
-
-_POOL: list = []
-
-
-def _pool() -> ThreadPoolExecutor:
-    """One worker thread for the second of two starts fitted at once (made on first use; a forked child makes
-    its own: a pool's thread does not survive a fork)."""
-    if not _POOL:
-        _POOL.append(ThreadPoolExecutor(1, thread_name_prefix="fruitimpact-joint-fit"))
-    return _POOL[0]
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_POOL.clear)
-
-
-def _fits(ts, y, weights, starts):
-    """The joint fits of ``starts`` in order, two at a time (the second on the worker thread); a generator, so the
-    caller may stop after any (a second fit running then finishes unused)."""
-    for k in range(0, len(starts), 2):
-        pair = starts[k:k + 2]
-        other = _pool().submit(_joint_fit, ts, y, weights, *pair[1]) if len(pair) == 2 else None
-        yield pair[0], _joint_fit(ts, y, weights, *pair[0])
-        if other is not None:
-            yield pair[1], other.result()
-
-
-def _separated(model, ts, y, noise, fitted, prior=None):
-    """(χ², misfit, θ, covariance, rms, iterations) of the joint fit ``fitted`` (``_joint_fit``'s result) when it
-    is accepted (module docstring), else None."""
-    theta, jac, _, iterations, converged, _ = fitted
+        theta, jac, _, iterations, converged, _ = fit_pulse_sum(
+            ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
+            max_iterations=SPLIT_ITERATIONS)
     if not np.all(np.isfinite(theta)):
         return None
     try:  # a degenerate pulse (a peak or duration beyond double precision) is a failed separation
