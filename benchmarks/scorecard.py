@@ -199,13 +199,14 @@ def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
             raise SystemExit(f"{label} seed {seed}: analyze failed ({proc.returncode}):\n{proc.stderr}")
         reports = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
         card = lg.score(reports, truth)
-        pairs = lg.match(reports, truth)["pairs"]
+        matched = lg.match(reports, truth)
+        pairs = matched["pairs"]
         card["lone_fruit_overlaps"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
                                           and r.get("status") == "overlap")
-        card["carried"], card["carried_flagged"] = _carried(reports, truth)
+        card["carried"], card["carried_flagged"] = _carried(reports, matched["missed"])
         # fruit that landed alone flagged as perhaps carrying a rebound (the price of that flag)
         card["lone_fruit_flagged"] = sum(1 for c, r in pairs if not c["is_rebound"] and r.get("status") == "ok"
-                                         and (r.get("rebound_evidence") or {}).get("ambiguous") is True
+                                         and _may_carry(r)
                                          and not any(d["is_rebound"] and d["lane"] == c["lane"]
                                                      and abs(d["start_time"] - c["start_time"]) < 3e-3
                                                      for d in truth["contacts"]))
@@ -239,20 +240,30 @@ def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
     return 0
 
 
-def _carried(reports: list[dict], truth: dict) -> tuple[int, int]:
-    """(fruit graded through a rebound they carry, of them flagged): truth rebounds no report found whose start lies
-    inside a graded fruit's report of their lane (status ok, no rebound: one pulse fitted through both, issue 13
-    item 2), and of those the reports with ``rebound_ambiguous`` (said, not silent)."""
-    missed = [c for c in lg.match(reports, truth)["missed"] if c["is_rebound"]]
+def _may_carry(report: dict) -> bool:
+    """The report says it may be a fruit and a rebound landed together (``rebound_evidence.ambiguous`` of
+    ``rebounds.landed_with_rebound``)."""
+    return (report.get("rebound_evidence") or {}).get("ambiguous") is True
+
+
+def _carried(reports: list[dict], missed: list[dict]) -> tuple[int, int]:
+    """(fruit graded through a rebound they carry, of them flagged): truth rebounds no report found (``missed`` of
+    ``lg.match``) whose start lies inside a graded fruit's report of their lane (status ok, no rebound: one pulse
+    fitted through both, issue 13 item 2), and of those the reports that say so (``_may_carry``).  A report whose
+    duration is not a number spans its start alone."""
     carried = flagged = 0
-    for c in missed:
+    for c in (c for c in missed if c["is_rebound"]):
         holder = next((r for r in reports if r.get("lane") == c["lane_name"] and r.get("status") == "ok"
                        and not r.get("rebound") and r["start_time"] - 2e-3 <= c["start_time"]
-                       <= r["start_time"] + (r.get("contact_duration") or 0.0)), None)
+                       <= r["start_time"] + _finite(r.get("contact_duration"))), None)
         if holder is not None:
             carried += 1
-            flagged += bool(holder.get("rebound_ambiguous"))
+            flagged += _may_carry(holder)
     return carried, flagged
+
+
+def _finite(value) -> float:
+    return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else 0.0
 
 
 def main(argv=None) -> int:

@@ -675,6 +675,7 @@ def test_a_fruit_and_a_rebound_landing_within_a_tenth_of_a_millisecond_are_an_ov
         report = _reports(alone)[-1]
         assert report["status"] == "ok" and not report["rebound"], report["message"]
         assert not math.isnan(report["firmness_c"])
+        assert not report["rebound_ambiguous"], report["rebound_evidence"]  # 1.3 times: 1.75 sd, not flagged
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -688,10 +689,9 @@ def test_a_fruit_that_may_carry_a_due_rebound_is_graded_and_flagged(seed):
     (``rebound_ambiguous``, the evidence with ``ambiguous``: rebounds.LANDED_AMBIGUOUS_Z), never silently.  A
     fruit 1.3 times the lot's mass (1.75 sd) is not flagged (the test above).  (With the rebound, a joint fit may
     also find two pulses it cannot part: an overlap, no firmness, as honest.)"""
-    for x in (_lane_then_fruit_with_rebound(seed, next_mass=0.85)[1],
-              _lane_then_fruit_with_rebound(seed, next_mass=1.45, with_rebound=False)[1]):
-        report = _reports(x)[-1]
-        if report["status"] == "overlap" and "could not be told apart" in report["message"]:
+    for with_rebound, mass in ((True, 0.85), (False, 1.45)):
+        report = _reports(_lane_then_fruit_with_rebound(seed, next_mass=mass, with_rebound=with_rebound)[1])[-1]
+        if with_rebound and report["status"] == "overlap" and "could not be told apart" in report["message"]:
             assert math.isnan(report["firmness_c"])
             continue
         assert report["status"] == "ok" and not report["rebound"], report["message"]
@@ -749,6 +749,7 @@ def test_two_rebounds_landing_together_are_no_fruit(seed):
     *_, first, second, both = _reports(_two_rebounds_due(seed, rebounds))
     assert both["status"] == "overlap" and both["message"].startswith("two rebounds landing together")
     assert both["rebound"] and math.isnan(both["firmness_c"]) and both.get("class") is None
+    assert not both["rebound_ambiguous"], both["rebound_evidence"]
     assert sorted(both["rebound_evidence"]["parents"]) == [first["sequence"], second["sequence"]]
     for mass in (1.0, 1.3):
         new = _reports(_two_rebounds_due(seed, lambda a, b, landing: ([landing], [impact(mass=mass * MASS,
@@ -1346,6 +1347,7 @@ def test_two_rebounds_landing_together_before_the_lane_has_three_fruit(seed):
     assert not first["rebound"] and not second["rebound"]
     assert both["status"] == "overlap" and both["rebound"], both["message"]
     assert both["message"].startswith("two rebounds landing together") and math.isnan(both["firmness_c"])
+    assert not both["rebound_ambiguous"], both["rebound_evidence"]
     new = reports([0.1, onset_b, landing], [a, b, impact(mass=MASS, restitution=0.58)])[-1]
     assert new["status"] == "ok" and not new["rebound"], new["message"]
 
@@ -1621,3 +1623,24 @@ def test_a_fruit_of_the_lot_landing_off_a_hidden_fruits_rebound_flight_is_not_ex
     for late in (0.6, 0.65, 0.7, 1.4):
         verdict = judge_unmeasured(summary(apple, left + late * flight, 99), 42, 1.0, fruit, V_LINE)
         assert not verdict.rebound, (late, verdict.evidence)
+
+
+def test_a_heavy_fruit_on_a_lane_whose_fruit_never_rebound_is_not_flagged():
+    """On a lane whose first ``QUIET_LANE_FRUIT`` fruit showed no rebound at all (a pad, a brush or a cup stops
+    them), no rebound is expected to land: a fruit 1.45 times the lot's mass (2.5 sd, where the last fruit's rebound
+    would have been due on a plate) is graded without the "perhaps a fruit and a rebound" flag that the same fruit
+    gets on a lane that has shown rebounds (test above)."""
+    from fruitimpact.signals.rebounds import QUIET_LANE_FRUIT
+
+    rng = np.random.default_rng(7)
+    count = QUIET_LANE_FRUIT + 2
+    fruit = [impact(mass=MASS * rng.uniform(0.9, 1.1), restitution=rng.uniform(0.55, 0.6)) for _ in range(count)]
+    onsets = [0.1 + 0.1 * k for k in range(count)]
+    last = fruit[-1]
+    landing = onsets[-1] + last["T"] + 2 * last["e"] * V_LINE / G  # where its rebound would land on a plate
+    x = _signal([*onsets, landing - 5e-5], [*fruit, impact(mass=1.45 * MASS, restitution=0.57)],
+                int((landing + 0.1) * RATE), seed=7)
+    x = x + np.random.default_rng(107).normal(0.0, 0.02 * fruit[0]["F"], x.size)
+    reports = _reports(x)
+    assert len(reports) == count + 1 and not any(r["rebound"] for r in reports)
+    assert reports[-1]["status"] == "ok" and not reports[-1]["rebound_ambiguous"], reports[-1]["message"]

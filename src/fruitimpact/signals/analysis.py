@@ -365,6 +365,8 @@ class LineAnalyzer:
                 together, together_parents = landed
             found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None and due else None
             pair, pair_parents = found if found is not None else (None, None)
+            if pair is not None:  # two rebounds, no fruit: nothing to flag as a fruit
+                maybe_together = None
         elif piece and not rebound and status == "ok" and summary is not None:
             # a piece of a split judged a new fruit may be two rebounds the joint fit took for one pulse (a fruit and
             # two rebounds 1-2 ms apart, fitted as two pulses: seen on tests/linegen.py's chain10 at seed 36); the
