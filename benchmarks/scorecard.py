@@ -203,13 +203,10 @@ def sweep(jobs: list[tuple[str, int, "lg.Scenario"]]) -> int:
         pairs = matched["pairs"]
         card["lone_fruit_overlaps"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
                                           and r.get("status") == "overlap")
-        card["carried"], card["carried_flagged"] = _carried(reports, matched["missed"])
-        # fruit that landed alone flagged as perhaps carrying a rebound (the price of that flag)
-        card["lone_fruit_flagged"] = sum(1 for c, r in pairs if not c["is_rebound"] and r.get("status") == "ok"
-                                         and _may_carry(r)
-                                         and not any(d["is_rebound"] and d["lane"] == c["lane"]
-                                                     and abs(d["start_time"] - c["start_time"]) < 3e-3
-                                                     for d in truth["contacts"]))
+        card["carried"], card["carried_flagged"] = _carried(matched)
+        # fruit that landed alone (overlapping no other contact) flagged as perhaps carrying a rebound: the flag's price
+        card["lone_fruit_flagged"] = sum(1 for c, r in pairs if not c["is_rebound"] and not c["overlaps"]
+                                         and r.get("status") == "ok" and _may_carry(r))
         return label, seed, card
 
     keys = ("extra", "fruit_taken_for_rebounds", "rebounds_taken_for_fruit", "lone_fruit_overlaps", "carried",
@@ -246,24 +243,19 @@ def _may_carry(report: dict) -> bool:
     return (report.get("rebound_evidence") or {}).get("ambiguous") is True
 
 
-def _carried(reports: list[dict], missed: list[dict]) -> tuple[int, int]:
-    """(fruit graded through a rebound they carry, of them flagged): truth rebounds no report found (``missed`` of
-    ``lg.match``) whose start lies inside a graded fruit's report of their lane (status ok, no rebound: one pulse
-    fitted through both, issue 13 item 2), and of those the reports that say so (``_may_carry``).  A report whose
-    duration is not a number spans its start alone."""
+def _carried(matched: dict) -> tuple[int, int]:
+    """(fruit graded through a rebound they carry, of them flagged), from ``lg.match``: truth rebounds no report
+    found whose truth contact overlaps a fruit paired with a graded report (status ok, no rebound: one pulse fitted
+    through both, issue 13 item 2), and of those the reports that say so (``_may_carry``)."""
+    graded = {c["index"]: r for c, r in matched["pairs"]
+              if not c["is_rebound"] and r.get("status") == "ok" and not r.get("rebound")}
     carried = flagged = 0
-    for c in (c for c in missed if c["is_rebound"]):
-        holder = next((r for r in reports if r.get("lane") == c["lane_name"] and r.get("status") == "ok"
-                       and not r.get("rebound") and r["start_time"] - 2e-3 <= c["start_time"]
-                       <= r["start_time"] + _finite(r.get("contact_duration"))), None)
+    for c in (c for c in matched["missed"] if c["is_rebound"]):
+        holder = next((graded[k] for k in c["overlaps"] if k in graded), None)
         if holder is not None:
             carried += 1
             flagged += _may_carry(holder)
     return carried, flagged
-
-
-def _finite(value) -> float:
-    return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else 0.0
 
 
 def main(argv=None) -> int:

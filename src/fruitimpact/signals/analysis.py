@@ -352,21 +352,18 @@ class LineAnalyzer:
             if (hidden.rebound or hidden.ambiguous) and (not judged or _score(hidden) < _score(verdict)):
                 chosen, hidden_fruit = hidden, True
         rebound = chosen is not None and chosen.rebound
-        together = together_parents = pair = pair_parents = maybe_together = None
+        together = together_parents = pair = pair_parents = may_carry = flagged = None
         hidden_due = self._hidden_fruit_due(impact.lane, summary) \
             if not rebound and status == "ok" and summary is not None and not piece else []
         if not rebound and status == "ok" and summary is not None and (due or hidden_due):
             lane_fruit = self._lane_fruit(impact.lane)
             landed = landed_with_rebound(summary, [*due, *hidden_due], lane_fruit)
-            if landed is not None and landed[0]["ambiguous"]:  # graded as the fruit it may be, and flagged
-                # (not on a lane whose fruit have shown no rebound: a pad stops them, none is expected to land)
-                maybe_together = landed[0] if self._quiet_fruit(impact.lane) < QUIET_LANE_FRUIT else None
+            if landed is not None and landed[0]["ambiguous"]:
+                may_carry = landed[0]  # a fruit, or a fruit and a rebound: decided below
             elif landed is not None:
                 together, together_parents = landed
             found = rebounds_landed_together(summary, list(due), lane_fruit) if together is None and due else None
             pair, pair_parents = found if found is not None else (None, None)
-            if pair is not None:  # two rebounds, no fruit: nothing to flag as a fruit
-                maybe_together = None
         elif piece and not rebound and status == "ok" and summary is not None:
             # a piece of a split judged a new fruit may be two rebounds the joint fit took for one pulse (a fruit and
             # two rebounds 1-2 ms apart, fitted as two pulses: seen on tests/linegen.py's chain10 at seed 36); the
@@ -403,12 +400,12 @@ class LineAnalyzer:
             status, chosen, summary, rebound, hidden_fruit = "overlap", None, None, True, False
             message = f"two rebounds landing together: {pair['reason']}; no firmness"
             without_firmness(report)
-        elif maybe_together is not None and not rebound and orphan is None \
-                and not (chosen is not None and chosen.ambiguous):  # said, not silently guessed
-            chosen, hidden_fruit = None, False
-            message = f"perhaps a fruit and a rebound landing together: {maybe_together['reason']}"
-        else:
-            maybe_together = None
+        elif may_carry is not None and not rebound and orphan is None \
+                and not (chosen is not None and chosen.ambiguous) and self._quiet_fruit(impact.lane) < QUIET_LANE_FRUIT:
+            # graded as the fruit it may be and flagged: said, not silently guessed (not on a lane whose fruit have
+            # shown no rebound: a pad stops them, none is expected to land)
+            chosen, hidden_fruit, flagged = None, False, may_carry
+            message = f"perhaps a fruit and a rebound landing together: {flagged['reason']}"
         speed = self.line_speed(impact.lane)
         read = analysis.velocity is None  # a speed read from the lane's rebounds: no flight is tested against it
         landing = math.nan  # the impact speed its own flight shows, for its next bounce (a hidden fruit's rebound)
@@ -446,9 +443,9 @@ class LineAnalyzer:
         report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound and not unnamed else
                       pair["parents"][0] if pair is not None else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None
-                                             or maybe_together is not None),
+                                             or flagged is not None),
                       rebound_evidence=chosen.evidence if chosen is not None
-                      else together or pair or orphan or maybe_together)
+                      else together or pair or orphan or flagged)
         if analysis.fit and shape is not None and status != "overlap":
             result = restated(shape, analysis, speed)
             merge_fit(report, result)

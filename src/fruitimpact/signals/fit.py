@@ -198,13 +198,13 @@ def derived(theta, velocity, mass, diameter, poisson, dimless=None) -> np.ndarra
                      peak / time_to_peak ** 2, m * v * (1.0 + e)])
 
 
-def _derived_stderr(theta, covariance, args) -> np.ndarray:
-    """Standard errors of ``derived`` by the delta method (central differences in θ)."""
+def _derived_stderr(theta, covariance, args, dimless) -> np.ndarray:
+    """Standard errors of ``derived`` by the delta method (central differences in θ; ``dimless``: the engine's
+    characteristics at θ's x, the same for the steps in t0, peak and duration)."""
     sd = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     floor = np.array([1e-9 * math.exp(theta[2]), 1e-9, 1e-9, 1e-9])
     steps = np.maximum(1e-4 * sd, floor)
     columns = []
-    dimless = _dimensionless(theta[3])  # the same for the steps in t0, peak and duration
     for i in range(4):
         up, down = theta.copy(), theta.copy()
         up[i] += steps[i]
@@ -225,8 +225,9 @@ def named_result(theta, covariance, args, t_ref: float) -> dict:
     relative to ``t_ref`` [s]) and its 4×4 covariance; ``args`` = (velocity, mass, diameter, poisson) as
     given to the fit (a given velocity or mass has standard error 0; no diameter, no modulus error)."""
     velocity, mass, diameter, _ = args
-    values = derived(theta, *args)
-    errors = _derived_stderr(theta, covariance, args) if np.all(np.isfinite(covariance)) \
+    dimless = _dimensionless(theta[3])
+    values = derived(theta, *args, dimless)
+    errors = _derived_stderr(theta, covariance, args, dimless) if np.all(np.isfinite(covariance)) \
         else np.full(values.shape, np.nan)
     result = {}
     for name, value, error in zip(_FIT_NAMES, values, errors):
