@@ -168,6 +168,11 @@ function drawTable(a) {
       const td = document.createElement("td");
       td.textContent = cell(row, key, scale, k);
       if (key === "status" && row.status !== "ok") { td.className = "flag"; td.title = row.message || ""; }
+      else if (key === "status" && row.rebound_ambiguous) {  // kept as read, but the evidence was not clear-cut
+        td.textContent = "ok, ambiguous";
+        td.className = "flag";
+        td.title = row.message || "the rebound decision is ambiguous: see rebound_evidence in the JSON lines";
+      }
       tr.appendChild(td);
     }
     return tr;
