@@ -28,7 +28,8 @@ extra reports, fruit taken for rebounds, rebounds taken for fruit, lone fruit re
 through a rebound they carry, i.e. one pulse fitted through both, and how many of those say so with
 ``rebound_ambiguous``; lone fruit flagged that way).
 ``--variants``: the same at other settings of the generator (``VARIANTS``: flights ±20 %, spin to 15 %, 10 kHz,
-twice the noise, 3 and 6 cm drops, a restitution that does not change with speed), at seeds 1,2 or ``--seeds``.
+twice the noise, 3 and 6 cm drops, a restitution that does not change with speed, fruit whose force law is not
+Hertz's: δ^1.3 and δ^1.7), at seeds 1,2 or ``--seeds``.
 
 The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
 """
@@ -181,6 +182,9 @@ VARIANTS = {
     "chain10/LN": ("chain10", {"damping_law": "lankarani-nikravesh"}),
     "chain7/Flores": ("chain7", {"damping_law": "flores"}),
     "close/Flores": ("close", {"damping_law": "flores"}),
+    "pad/n=1.3": ("pad", {"force_exponent": 1.3}),
+    "chain10/n=1.3": ("chain10", {"force_exponent": 1.3}),
+    "lanes4/n=1.7": ("lanes4", {"force_exponent": 1.7}),
 }
 
 

@@ -12,6 +12,9 @@ Physics of one contact (Hunt–Crossley sphere on a rigid plate)
     by ``solve_ivp`` (DOP853, rtol 1e-10) from δ = 0 with two events: the force maximum (dF/dt = 0) and the
     separation (δ back to 0).  ``damping_law`` (``DAMPING_LAWS``) may instead make the restitution the fruit's
     constant (c = χ(e₀)/V per contact: Lankarani–Nikravesh, Flores): a rebound is then as lively as its fruit.
+    ``force_exponent`` n ≠ 1.5 gives the fruit a force law that is not Hertz's, F = K_n δ^n (1 + c δ̇), with K_n
+    chosen for the same force at the fruit's undamped Hertz compression at the line's V (``contact``): a pulse
+    that the analysis's Hertz law cannot fit exactly, as real fruit (not homogeneous spheres) give.
     The force is tabulated on a fine grid (8193 points over the contact) and
     interpolated at the recording's (oversampled) sample times, so onsets fall anywhere between samples.
 
@@ -142,14 +145,23 @@ class Pulse:
         return np.interp(t, self.table_t, self.table_f, left=0.0, right=0.0)
 
 
-def contact(K: float, mass: float, damping: float, velocity: float, rtol: float = 1e-10) -> Pulse:
-    """Integrate m δ̈ = −K δ^1.5 (1 + c δ̇) from δ = 0, δ̇ = V to separation (``solve_ivp``, DOP853)."""
-    k_over_m = K / mass
+def contact(K: float, mass: float, damping: float, velocity: float, rtol: float = 1e-10, exponent: float = 1.5,
+            reference_velocity: float | None = None) -> Pulse:
+    """Integrate m δ̈ = −K_n δ^n (1 + c δ̇) from δ = 0, δ̇ = V to separation (``solve_ivp``, DOP853).
+
+    n = ``exponent``: 1.5 is Hertz's sphere (K_n = K).  Another n is a fruit whose force law is not Hertz's (a
+    turgid cell body's exponent lies between 1 and 2: Blahovec, Int. Agrophys. 10(2):89–95, 1996):
+    K_n = K δ_r^(1.5 − n), the same force as Hertz's law at δ_r, the undamped Hertz compression at
+    ``reference_velocity`` (default V; a rebound passes its fruit's first V, so the fruit keeps one force law).
+    ``Pulse.K`` stays K."""
+    n = exponent
+    k_law = K * hertz_max_deflection(K, mass, reference_velocity or velocity) ** (1.5 - n)
+    k_over_m = k_law / mass
     c = damping
 
     def force_of(d, v):
         d = np.maximum(d, 0.0)
-        return np.maximum(K * d ** 1.5 * (1.0 + c * v), 0.0)
+        return np.maximum(k_law * d ** n * (1.0 + c * v), 0.0)
 
     def rhs(t, y):
         return [y[1], -float(force_of(y[0], y[1])) / mass]
@@ -163,11 +175,12 @@ def contact(K: float, mass: float, damping: float, velocity: float, rtol: float 
     def peak(t, y):  # dF/dt / K, positive while loading; zero at t = 0 (δ = 0), crossed downwards at the peak
         d = max(y[0], 0.0)
         v = y[1]
-        acc = -k_over_m * d ** 1.5 * (1.0 + c * v)
-        return 1.5 * math.sqrt(d) * v * (1.0 + c * v) + d ** 1.5 * c * acc
+        acc = -k_over_m * d ** n * (1.0 + c * v)
+        return n * d ** (n - 1.0) * v * (1.0 + c * v) + d ** n * c * acc
 
     peak.direction = -1
-    dm = hertz_max_deflection(K, mass, velocity)
+    # undamped compression: ½ m V² = K_n δ^(n+1)/(n+1)
+    dm = ((n + 1.0) * mass * velocity ** 2 / (2.0 * k_law)) ** (1.0 / (n + 1.0))
     t_hertz = 2.0 * HERTZ_TIME * dm / velocity
     sol = solve_ivp(rhs, (0.0, 20.0 * t_hertz), [0.0, velocity], method="DOP853", rtol=rtol,
                     atol=[1e-12 * dm, 1e-12 * velocity], events=[separation, peak], dense_output=True)
@@ -245,6 +258,7 @@ class Scenario:
     spin_loss: tuple[float, float] = (0.0, 0.04)  # uniform fraction of V_up lost before the rebound lands
     spot_stiffness: float = 0.05                # uniform ± fraction of K where a rebound lands
     damping_law: str = "hunt-crossley"          # how c depends on the contact's speed (``DAMPING_LAWS``)
+    force_exponent: float = 1.5                 # n of the fruit's force law K_n δ^n (1.5: Hertz; ``contact``)
     kinds: tuple[tuple[FruitKind, float], ...] = ((APPLE, 1.0),)  # kinds and their shares
     drop_height: float = 0.05                   # [m]
     noise: float = 0.01                         # white-noise σ / median primary peak
@@ -371,9 +385,10 @@ def _contacts(scenario: Scenario, size: int, rng) -> tuple[list[dict], list[dict
                 if previous_end is not None and start <= previous_end:  # cannot happen at these pitches
                     start = previous_end + scenario.close_gap[1]
             damping_of = DAMPING_LAWS[scenario.damping_law]
+            law = dict(exponent=scenario.force_exponent, reference_velocity=V)
             if scenario.damping_law != "hunt-crossley":
-                fruit["e0"] = contact(fruit["stiffness"], fruit["mass"], fruit["damping"], V).restitution
-            pulse = contact(fruit["stiffness"], fruit["mass"], damping_of(fruit, V), V)
+                fruit["e0"] = contact(fruit["stiffness"], fruit["mass"], fruit["damping"], V, **law).restitution
+            pulse = contact(fruit["stiffness"], fruit["mass"], damping_of(fruit, V), V, **law)
             primary = dict(lane=lane, lane_name=names[lane], fruit_id=fruit_id, kind=fruit["kind"], start_time=start,
                            pulse=pulse, is_rebound=False, parent=None, close_arrival=bool(close), flight_time=None,
                            modulus=fruit["modulus"], diameter=fruit["diameter"], poisson=fruit["poisson"])
@@ -389,7 +404,7 @@ def _contacts(scenario: Scenario, size: int, rng) -> tuple[list[dict], list[dict
                 flight = 2.0 * v_up / G * (1.0 + rng.uniform(-1.0, 1.0) * scenario.flight_jitter)
                 v2 = v_up * (1.0 - rng.uniform(*scenario.spin_loss))
                 k2 = fruit["stiffness"] * (1.0 + rng.uniform(-1.0, 1.0) * scenario.spot_stiffness)
-                p2 = contact(k2, fruit["mass"], damping_of(fruit, v2), v2)
+                p2 = contact(k2, fruit["mass"], damping_of(fruit, v2), v2, **law)
                 rebound = dict(lane=lane, lane_name=names[lane], fruit_id=fruit_id, kind=fruit["kind"],
                                start_time=parent["start_time"] + parent["pulse"].duration + flight, pulse=p2,
                                is_rebound=True, parent=parent, close_arrival=False, flight_time=flight,

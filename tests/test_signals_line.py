@@ -134,6 +134,26 @@ def test_impulse_of_the_tabulated_force_is_m_one_plus_e_v():
     assert p.peak_force == pytest.approx(p.table_f.max(), rel=1e-9)
 
 
+@pytest.mark.parametrize("exponent", [1.3, 1.7])
+def test_a_force_law_other_than_hertz_conserves_energy_and_keeps_hertz_force_at_the_reference(exponent):
+    """The generator's fruit whose force law is K_n δ^n (``force_exponent``, a fruit that is not a homogeneous
+    Hertz sphere: Blahovec, Int. Agrophys. 10(2):89–95, 1996, finds exponents between 1 and 2): undamped, the
+    fruit leaves at the speed it came (e = 1 to the integrator's 1e-8) and compresses to the closed form of the
+    energy balance, ½ m V² = K_n δ^(n+1)/(n+1), with K_n δ_r^n = K δ_r^1.5 at δ_r, Hertz's compression at the
+    reference speed (to 1e-6: the table's resolution of the maximum).  A rebound keeps its fruit's law: at half the
+    speed with the fruit's reference, the force at δ_r is still Hertz's."""
+    K, m, V = 1.1e6, 0.21, 0.99
+    hertz = lg.hertz_max_deflection(K, m, V)
+    k_law = K * hertz ** (1.5 - exponent)
+    p = lg.contact(K, m, 0.0, V, exponent=exponent)
+    assert p.restitution == pytest.approx(1.0, abs=1e-8)
+    assert p.max_deflection == pytest.approx(((exponent + 1) * m * V ** 2 / (2 * k_law)) ** (1 / (exponent + 1)),
+                                             rel=1e-6)
+    assert p.K == K  # the truth keeps the Hertz stiffness the fruit's modulus gives
+    slow = lg.contact(K, m, 0.0, 0.5 * V, exponent=exponent, reference_velocity=V)
+    assert slow.peak_force == pytest.approx(k_law * slow.max_deflection ** exponent, rel=1e-6)
+
+
 def test_fruit_stiffness_is_the_hertz_sphere_on_a_plate():
     """K = (4/3) E/(1 − ν²) √(d/2) [N/m^1.5]; G is standard gravity as in conftest."""
     assert lg.stiffness(3e6, 0.35, 0.08) == pytest.approx(4 / 3 * 3e6 / (1 - 0.35 ** 2) * math.sqrt(0.04))
@@ -355,6 +375,52 @@ def test_line_of_fruit_whose_restitution_does_not_change_with_speed_meets_the_is
     missed = [f"{key} = {card[key]:.4g} (goal {op} {limit}: {REASONS[key]})"
               for key, (op, limit) in lg.GOALS.items() if not lg.check(card)[key]]
     assert not missed, f"{name}/{law}: " + "; ".join(missed) + f"\nscorecard: {card}"
+
+
+def test_fruit_whose_force_law_is_not_hertz_are_graded_not_reported_as_overlaps(cli, tmp_path):
+    """A fruit whose force rises as δ^1.3 instead of Hertz's δ^1.5 (``linegen`` ``force_exponent``; real fruit are
+    not homogeneous spheres) leaves about 1 % of its peak that one Hertz pulse cannot fit, as much as the noise.
+    A second pulse takes that up, so each contact in which a rebound was due was fitted better as two (by more
+    than ``analysis.SPLIT_GAIN``) and reported as two pulses that could not be told apart, no firmness: 13 of the
+    22 fruit on this pad line (44 of 80 at benchmark size).  The lane now learns what its lone fruit leave
+    (``LineAnalyzer.lane_misfit``) and a split has to gain more than that: only the contacts before the lane has
+    ``LANE_MISFITS_MIN`` behind it can still be taken for overlaps.  Every contact is found, none invented, none
+    misread as a rebound.  The stiffness fitted with Hertz's law to such a pulse is off by ~4.5 % (the law's own
+    error, not the line's): the issue's 2 % goal is for Hertz's fruit and is not asserted here."""
+    from fruitimpact.signals.analysis import LANE_MISFITS_MIN
+
+    scenario = dataclasses.replace(lg.SCENARIOS["pad"], force_exponent=1.3)
+    path, truth = lg.write(scenario, tmp_path, scenario.quick_size)
+    status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))
+    assert status == 0, err
+    reports = [json.loads(line) for line in out.splitlines()]
+    card = lg.score(reports, truth)
+    assert (card["recall"], card["extra"], card["fruit_taken_for_rebounds"], card["rebounds_taken_for_fruit"]) \
+        == (1.0, 0, 0, 0), card
+    pairs = lg.match(reports, truth)["pairs"]
+    taken = [r for c, r in pairs if not c["is_rebound"] and not c["overlaps"] and r.get("status") == "overlap"]
+    assert len(taken) <= LANE_MISFITS_MIN - 2, [r["message"] for r in taken]  # 13 before
+    assert card["stiffness_median"] < 0.08  # Hertz's law fitted to δ^1.3: biased, not lost
+
+
+def test_the_lanes_own_misfit_is_its_median_beyond_what_hertz_lines_leave():
+    """``LineAnalyzer.lane_misfit``: nothing until ``LANE_MISFITS_MIN`` contacts are in, then the median of the
+    last ``LANE_MISFITS_KEPT`` (two fruit landing together among them do not move it) beyond
+    ``HERTZ_LINE_MISFIT`` in quadrature (what plate ringing and hum leave on Hertz's own pulses); per lane."""
+    from fruitimpact.signals.analysis import (HERTZ_LINE_MISFIT, LANE_MISFITS_KEPT, LANE_MISFITS_MIN, Analysis)
+
+    analyzer = Analysis(rate=20_000.0).analyzer()
+    for _ in range(LANE_MISFITS_MIN - 1):
+        analyzer._misfit_seen(0, 0.01)
+    assert analyzer.lane_misfit(0) == 0.0
+    analyzer._misfit_seen(0, 0.01)
+    assert analyzer.lane_misfit(0) == pytest.approx(math.sqrt(0.01 ** 2 - HERTZ_LINE_MISFIT ** 2))
+    for _ in range(LANE_MISFITS_KEPT):
+        analyzer._misfit_seen(1, 0.004)
+    analyzer._misfit_seen(1, 0.08)  # a fruit and a rebound landing together
+    assert analyzer.lane_misfit(1) == 0.0  # a Hertz line's ringing and hum: no force-law misfit
+    analyzer._misfit_seen(1, math.nan)  # a contact without a single fit leaves the lane as it was
+    assert analyzer.lane_misfit(1) == 0.0 and analyzer.lane_misfit(0) > 0.0
 
 
 @pytest.mark.parametrize("law, inside, outside", [("hunt-crossley", 1.0, 0.0), ("lankarani-nikravesh", 0.0, 1.0)])
