@@ -403,6 +403,30 @@ def test_fruit_whose_force_law_is_not_hertz_are_graded_not_reported_as_overlaps(
     assert card["stiffness_median"] < 0.08  # Hertz's law fitted to δ^1.3: biased, not lost
 
 
+@pytest.mark.parametrize("name", ["chain7", "close"])
+def test_noise_alone_does_not_make_a_contact_two_pulses(cli, tmp_path, name):
+    """At 3 % noise (σ = 3 % of the median fruit's peak: 2.4 N) a rebound of 35 N rises again after its top by 2σ
+    of its own noise, 12–14 % of its peak: above ``analysis.OVERLAP_FRACTION``, so it was reported as two pulses
+    (3 lone contacts on chain7 at this size; on close, 3 overlaps whose start, the trigger, lay more than 1 ms after
+    the onset: missed and extra).  A dip counts now only beyond ``DIP_NOISE_SD`` = 4 σ (one pulse's noise reaches
+    3.7 σ at most on these lines), and a misfit only beyond 3 sd of its own χ² scatter (``MISFIT_SD``).  Every
+    contact is found, none invented, and every report of a dip holds two contacts: its own and one landing within
+    it or up to 2 ms after the end the detector saw (a neighbour's rise enters the window before the neighbour's
+    force crosses the detector's threshold, 6 σ: 17 % of an 84 N fruit at this noise)."""
+    scenario = dataclasses.replace(lg.SCENARIOS[name], noise=0.03)
+    path, truth = lg.write(scenario, tmp_path, scenario.quick_size)
+    status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))
+    assert status == 0, err
+    reports = [json.loads(line) for line in out.splitlines()]
+    card = lg.score(reports, truth)
+    assert (card["recall"], card["extra"]) == (1.0, 0), card
+    dips = [r for r in reports if r.get("status") == "overlap" and "falls and rises again" in r.get("message", "")]
+    for r in dips:
+        inside = [c for c in truth["contacts"] if c["lane_name"] == r["lane"]
+                  and r["start_time"] - 1e-3 <= c["start_time"] <= r["start_time"] + r["contact_duration"] + 2e-3]
+        assert len(inside) >= 2, (r["start_time"], r["message"])
+
+
 def test_the_lanes_own_misfit_is_its_median_beyond_what_hertz_lines_leave():
     """``LineAnalyzer.lane_misfit``: nothing until ``LANE_MISFITS_MIN`` contacts are in, then the median of the
     last ``LANE_MISFITS_KEPT`` (two fruit landing together among them do not move it) beyond
