@@ -645,6 +645,28 @@ def test_cardboard_protects_only_below_its_crush():
     assert "the board crushes" not in low.loc[1, "warnings"]
 
 
+def test_a_crushed_board_stays_crushed_for_the_later_bounces():
+    """Flat crush is permanent (the flutes under the fruit collapse and do not recover), and a drop's fruit lands
+    on the same spot (the accumulation rule): once the first impact has crushed the library cardboard, the later
+    impacts land on the floor that carried the force beyond the crush, rigid in the layer model, and the board does
+    no more work.  Before, every bounce met a fresh board: 2.1 mJ of crush work at each of the first 8 impacts of
+    an apple from 30 cm.  Independent of the drop loop: impact 2 equals one impact of the same fruit on the rigid
+    surface at that speed with the drop's damping c = (c/k)·k (bounces material), to rounding; and the sequence
+    keeps its energy (released = absorbed + left)."""
+    report = drop(0.3, fruit="apple", surface="cardboard")
+    impacts = report["impacts"]
+    assert impacts[0]["plastic_work"] > 0.0  # the crush
+    assert all(i["plastic_work"] == 0.0 for i in impacts[1:])
+    first = batch.evaluate({"fruit": ["apple"], "surface": ["cardboard"], "drop_height": [0.3]})
+    damping = float(first.loc[0, "damping_factor"]) * float(first.loc[0, "law_stiffness"])
+    again = batch.evaluate({"fruit": ["apple"], "surface": ["rigid"], "velocity": [impacts[1]["velocity"]],
+                            "damping": [damping]})
+    for key in ("peak_force", "restitution", "contact_duration"):
+        assert impacts[1][key] == pytest.approx(float(again.loc[0, key]), rel=1e-9), key
+    released = float(first.loc[0, "mass"]) * G * 0.3
+    assert report["total_absorbed_energy"] + report["energy_left"] == pytest.approx(released, rel=1e-9)
+
+
 # ------------------------------------------------------- defects found by the review of issue 14 (helper attack)
 @pytest.mark.parametrize("argv, option", [
     (("population", "-n", "50", "--fruit", "pear", "--drop-height", "4cm", "--criterion", "shear"), "--failure-stress"),

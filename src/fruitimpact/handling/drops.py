@@ -19,11 +19,11 @@ every output and in docs/damage.md): the fruit lands on the same spot every
 time.  A re-impact reloads the flattened spot as Hertz with its enlarged
 radius R_p (TN98 eq 20) up to the same yield pressure p_y, and yields again
 beyond it (issue 14 item 8): a later bounce can add plastic work, never a
-pressure above p_y.  A crushable board (cardboard) is taken fresh at each
-bounce: the model keeps no crushed spot on the surface, so each later impact that reaches the board's
-flat-crush stress crushes it again and its crush work counts again (an apple from 30 cm onto the library's
-cardboard: 2.1 mJ at each of the first 8 impacts, though its flutes under the fruit collapsed at the
-first).  Each impact that meets the bruise criterion adds
+pressure above p_y.  A crushable board (cardboard) stays crushed: once its flutes under the fruit
+have collapsed, the later impacts land on the floor that carried the force beyond the crush (rigid, as
+in the layer model), with no board work.  Before, each bounce met a fresh board and crushed it again (an
+apple from 30 cm onto the library's cardboard: 2.1 mJ of crush work at each of its first 8 impacts).
+Each impact that meets the bruise criterion adds
 BS (W_f − W_th)₊ to the bruise volume.  Measured apple bruises keep growing over
 3–5 repeated equal impacts before they stabilise (Komarnicki & Stopa 2013;
 the pendulum studies of docs/damage.md): this rule does not reproduce that
@@ -48,9 +48,9 @@ FREE_PARTNER = ("a drop bounces on a fixed surface, not a free partner (surface 
 REST_HEIGHT = 1e-3
 #: Accumulation rule, named in every output.
 ACCUMULATION_RULE = ("same spot; later impacts reload the flattened spot (Hertz with its radius R_p) up to the "
-                     "yield pressure p_y and yield again beyond it; a crushable board is taken fresh at each "
-                     "bounce (no crushed spot is kept: its crush work counts again at every impact that crushes "
-                     "it); each impact meeting the criterion adds BS (W_f - W_th)+")
+                     "yield pressure p_y and yield again beyond it; once a board has crushed under the fruit, "
+                     "later impacts land on its floor (rigid); each impact meeting the criterion adds "
+                     "BS (W_f - W_th)+")
 
 _IMPACT_FIELDS = ("velocity", "restitution", "exit_velocity", "peak_force", "time_to_peak", "contact_duration",
                   "max_deflection", "max_pressure", "max_shear_stress", "absorbed_energy", "plastic_work",
@@ -157,6 +157,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     result, j = first, 0  # the impact's evaluation and its row there
     batch = None
     flattened = None
+    crushed = None  # the impact at which the board under the fruit crushed
     material_factor = float(first.columns["damping_factor"][0])
     if not math.isfinite(material_factor):
         material_factor = 0.0
@@ -172,6 +173,8 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             break
         if result.plastic_block is not None and result.plastic[j] and columns["permanent_deflection"] > 0.0:
             flattened = float(result.plastic_block[j, -1])  # the spot as this impact left it: R_p
+        if _crushed_board(result, j):
+            crushed = len(impacts)  # the board's flutes under the fruit collapsed at this impact
         rebound = columns["exit_velocity"]
         if rebound * rebound / (2.0 * STANDARD_GRAVITY) < rest_height or len(impacts) >= max_impacts:
             if len(impacts) >= max_impacts and rebound * rebound / (2.0 * STANDARD_GRAVITY) >= rest_height:
@@ -190,6 +193,12 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             next_row["yield_pressure"] = float(first.columns["yield_pressure"][0])
             next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
             next_row["diameter"] = 2.0 * flattened
+        if crushed is not None:
+            # the same spot of a crushed board: its flutes stay collapsed, so the fruit lands on the floor that
+            # carried the force beyond the crush (rigid, as in the layer model), with none of the board's work
+            for name in [name for name in next_row if name.startswith("surface")]:
+                next_row.pop(name)
+            next_row["surface"] = "rigid"
         if bounces == "material" and material_factor > 0.0:
             # the first impact's damping factor c = λ/k, a property of the flesh: λ = c k of this contact
             for name in ("restitution", "alpha", "damping"):
@@ -233,6 +242,16 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
         (math.nan if any(b and math.isnan(v) for b, v in zip(bruised, volumes)) else float(np.nansum(volumes))),
         "rest_time": rest, "status": status, "message": message, "warnings": warnings,
     }
+
+
+def _crushed_board(result, j: int) -> bool:
+    """Whether row ``j`` of an evaluation crushed its board: a layer with a flat-crush strength that the pressure
+    under the fruit reached (it bottomed out at the crush depth, ``impact.evaluation``)."""
+    from fruitimpact.engine.plastic import PLASTIC_COLUMNS
+
+    return result.plastic_block is not None and bool(result.plastic[j]) \
+        and result.plastic_block[j, PLASTIC_COLUMNS.index("bottomed_out")] == 1.0 \
+        and math.isfinite(float(result.columns["surface_crush_stress"][j]))
 
 
 def _bounces_at_once(first, row: dict, bounces: str, factor: float, rest_height: float, max_impacts: int):
