@@ -427,6 +427,26 @@ def test_noise_alone_does_not_make_a_contact_two_pulses(cli, tmp_path, name):
         assert len(inside) >= 2, (r["start_time"], r["message"])
 
 
+def test_a_contact_the_samples_cannot_judge_says_so_where_a_rebound_was_due(cli, tmp_path):
+    """At 3 % noise a small rebound (20–25 N under 2.4 N of noise, the detector's 6 σ threshold at 60 % of its
+    peak) can leave neither a falling edge for the indices nor a converged fit: no pulse for the rebound tests, and
+    it was reported as a new fruit (``rebound`` false) in silence.  Where a parent's rebound was due in it (its
+    flight within the tolerances), the report now says it could not judge: ``rebound_ambiguous`` true, evidence
+    ``judged: false`` with the parents due.  On grades at this size: 6 such contacts, every one a rebound in the
+    truth, none graded."""
+    scenario = dataclasses.replace(lg.SCENARIOS["grades"], noise=0.03)
+    path, truth = lg.write(scenario, tmp_path, scenario.quick_size)
+    status, out, err = cli.run("analyze", path, *lg.analyze_options(truth))
+    assert status == 0, err
+    reports = [json.loads(line) for line in out.splitlines()]
+    unjudged = [(c, r) for c, r in lg.match(reports, truth)["pairs"]
+                if (r.get("rebound_evidence") or {}).get("judged") is False]
+    assert unjudged
+    for contact, report in unjudged:
+        assert contact["is_rebound"] and report["rebound_ambiguous"] and report["status"] != "ok", report
+        assert report["rebound_evidence"]["due"] and "was due here" in report["rebound_evidence"]["reason"]
+
+
 def test_the_lanes_own_misfit_is_its_median_beyond_what_hertz_lines_leave():
     """``LineAnalyzer.lane_misfit``: nothing until ``LANE_MISFITS_MIN`` contacts are in, then the median of the
     last ``LANE_MISFITS_KEPT`` (two fruit landing together among them do not move it) beyond

@@ -469,6 +469,13 @@ class LineAnalyzer:
             # shown no rebound: a pad stops them, none is expected to land)
             chosen, hidden_fruit, flagged = None, False, may_carry
             message = f"perhaps a fruit and a rebound landing together: {flagged['reason']}"
+        unjudged = None
+        if summary is None and status in ("ok", "clipped") and due and not piece:
+            # no pulse to judge (an index lost in the noise and no converged fit: a weak rebound at high noise) while
+            # a rebound was due in it: "a new fruit" would be a guess, so it is said
+            unjudged = {"judged": False, "due": [parent.sequence for parent in due],
+                        "reason": f"the rebound of #{due[0].sequence} was due here, but the samples gave no pulse to "
+                                  f"test against it (an index not found and no converged fit)"}
         speed = self.line_speed(impact.lane)
         read = analysis.velocity is None  # a speed read from the lane's rebounds: no flight is tested against it
         landing = math.nan  # the impact speed its own flight shows, for its next bounce (a hidden fruit's rebound)
@@ -506,9 +513,9 @@ class LineAnalyzer:
         report.update(rebound=rebound, rebound_of=chosen.parent if chosen is not None and rebound and not unnamed else
                       pair["parents"][0] if pair is not None else None,
                       rebound_ambiguous=bool(chosen is not None and chosen.ambiguous or orphan is not None
-                                             or flagged is not None),
+                                             or flagged is not None or unjudged is not None),
                       rebound_evidence=chosen.evidence if chosen is not None
-                      else together or pair or orphan or flagged)
+                      else together or pair or orphan or flagged or unjudged)
         if analysis.fit and shape is not None and status != "overlap":
             result = restated(shape, analysis, speed)
             merge_fit(report, result)
