@@ -155,7 +155,12 @@ def contact(K: float, mass: float, damping: float, velocity: float, rtol: float 
     ``reference_velocity`` (default V; a rebound passes its fruit's first V, so the fruit keeps one force law).
     ``Pulse.K`` stays K."""
     n = exponent
-    k_law = K * hertz_max_deflection(K, mass, reference_velocity or velocity) ** (1.5 - n)
+    if not n >= 1.0:
+        raise ValueError(f"exponent must be >= 1 (the force's slope at first touch); got {n!r}")
+    reference = velocity if reference_velocity is None else reference_velocity
+    if not reference > 0.0:
+        raise ValueError(f"reference_velocity must be > 0; got {reference_velocity!r}")
+    k_law = K * hertz_max_deflection(K, mass, reference) ** (1.5 - n)
     k_over_m = k_law / mass
     c = damping
 
@@ -172,11 +177,12 @@ def contact(K: float, mass: float, damping: float, velocity: float, rtol: float 
     separation.terminal = True
     separation.direction = -1
 
-    def peak(t, y):  # dF/dt / K, positive while loading; zero at t = 0 (δ = 0), crossed downwards at the peak
+    def peak(t, y):  # dF/dt / K_n, positive while loading; zero at t = 0 (δ = 0), crossed downwards at the peak
         d = max(y[0], 0.0)
         v = y[1]
         acc = -k_over_m * d ** n * (1.0 + c * v)
-        return n * d ** (n - 1.0) * v * (1.0 + c * v) + d ** n * c * acc
+        root = math.sqrt(d) if n == 1.5 else d ** (n - 1.0)  # Hertz's as it always was, to the last bit
+        return n * root * v * (1.0 + c * v) + d ** n * c * acc
 
     peak.direction = -1
     # undamped compression: ½ m V² = K_n δ^(n+1)/(n+1)

@@ -152,6 +152,10 @@ def test_a_force_law_other_than_hertz_conserves_energy_and_keeps_hertz_force_at_
     assert p.K == K  # the truth keeps the Hertz stiffness the fruit's modulus gives
     slow = lg.contact(K, m, 0.0, 0.5 * V, exponent=exponent, reference_velocity=V)
     assert slow.peak_force == pytest.approx(k_law * slow.max_deflection ** exponent, rel=1e-6)
+    # damped: the peak event (dF/dt = 0 with its c·δ̈ term) is the force table's maximum
+    damped = lg.contact(K, m, 1.1, V, exponent=exponent)
+    assert damped.peak_force == pytest.approx(damped.table_f.max(), rel=1e-9)
+    assert 0.3 < damped.restitution < 0.8
 
 
 def test_fruit_stiffness_is_the_hertz_sphere_on_a_plate():
@@ -399,7 +403,9 @@ def test_fruit_whose_force_law_is_not_hertz_are_graded_not_reported_as_overlaps(
         == (1.0, 0, 0, 0), card
     pairs = lg.match(reports, truth)["pairs"]
     taken = [r for c, r in pairs if not c["is_rebound"] and not c["overlaps"] and r.get("status") == "overlap"]
-    assert len(taken) <= LANE_MISFITS_MIN - 2, [r["message"] for r in taken]  # 13 before
+    # only contacts judged before the lane had learnt (its first LANE_MISFITS_MIN, of which the first fruit has no
+    # rebound due and the second is fitted before any other fruit was): 13 before, 2 now
+    assert len(taken) <= LANE_MISFITS_MIN - 2, [r["message"] for r in taken]
     assert card["stiffness_median"] < 0.08  # Hertz's law fitted to δ^1.3: biased, not lost
 
 

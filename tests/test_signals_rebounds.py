@@ -324,6 +324,24 @@ def test_two_fruit_whose_pulses_the_samples_cannot_separate_are_one_overlap(gap,
     assert math.isnan(report["firmness_c"]) and "stiffness" not in report or report.get("stiffness") is None
 
 
+def test_two_fruit_on_a_noise_free_signal_are_never_one_fruit():
+    """A clean signal (a simulation, or a sensor whose noise is below its resolution: the detector's σ decays to 0)
+    of two fruit 1.5 ms apart: one unimodal pulse that the force law misses by 2.7 % of its peak.  With no noise
+    that misfit has no scatter, so it always counts (``analysis.MISFIT_SD`` weighs a misfit against the noise's
+    χ² scatter; a review found the test switched off at σ = 0, and the two fruit graded as one).  Never one fruit
+    fitted through both: an overlap, or two pieces."""
+    a = impact()
+    b = impact(mass=0.7 * MASS)
+    t = np.arange(6000) / RATE
+    x = np.zeros(t.size)
+    for onset, imp in ((0.1, a), (0.1015, b)):
+        inside = (t > onset) & (t < onset + imp["T"])
+        x[inside] += powerlaw_curves(imp["m"], imp["K"], imp["c"], imp["V"], t[inside] - onset)[2]
+    reports = _reports(x)
+    assert not (len(reports) == 1 and reports[0]["status"] == "ok"), reports[0]["message"]
+    assert all(r["status"] == "overlap" or "fruit in one contact" in r["message"] for r in reports)
+
+
 def _fruit_then_rebound_with_the_next(gap, next_mass, seed=5):
     """A fruit at 0.1 s, its rebound (the same m, K, c at e V) after the flight 2 e V/g, and the next fruit
     ``gap`` [s] before that rebound (negative: after it)."""

@@ -54,7 +54,7 @@ from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contac
 OVERLAP_FRACTION = 0.10
 #: ... when it is also beyond this many noise sd: one pulse's own noise makes the smoothed force rise again after
 #: its top by 1.4–1.6 σ at the median, 2.4–2.7 σ at p99 and 3.7 σ at most (tests/linegen.py's chain10, grades and
-#: noisy at 1 % and 3 % noise), which on a small rebound at 3 % noise is 12–14 % of its peak: before this bound,
+#: noisy at 1 % and 3 % noise); 2 σ at 3 % noise is 12–14 % of a 35–40 N rebound's peak: before this bound,
 #: 219 contacts in 16 such recordings were reported as overlaps of pulses that were not there.  At 1 % noise
 #: every overlap whose dip exceeds 10 % of its peak lies beyond 4 σ, so nothing changes there.
 DIP_NOISE_SD = 4.0
@@ -82,7 +82,7 @@ SPLIT_GAIN = 0.2
 #: the fruit's deflection): lone fruit left 0.8–1.0 % of their peak at the median, and 364 of them in 16
 #: recordings (about 1,900 contacts) were reported as two pulses that could not be told apart; 18 now.  An
 #: exponent of 1.7 leaves 0.5 %, as much as ringing and hum do on ``noisy``: the misfit does not tell the two
-#: apart, and such a line still loses grades to overlaps (104 → 72; docs/signals.md).
+#: apart, and such a line still loses grades to overlaps (104 → 73; docs/signals.md).
 LANE_MISFITS_KEPT, LANE_MISFITS_MIN, MODEL_MARGIN, HERTZ_LINE_MISFIT = 15, 5, 2.25, 0.005
 #: At most this many earlier contacts whose rebound is due guide a joint fit (the latest first; their hypotheses
 #: share the ``split.FITS`` fits; on a line of 10 fruit/s with two rebounds each, 1–3 are due at once).
@@ -169,7 +169,7 @@ class LineAnalyzer:
         peak = report["peak_force"]
         second = second_pulse(own)
         shape = None
-        misfit = math.nan  # the single pulse's, which the lane learns once this contact is decided (``lane_misfit``)
+        misfit = learnt = math.nan  # the single pulse's; the lane learns it when the contact is decided
         dip = second > max(OVERLAP_FRACTION * peak, DIP_NOISE_SD * impact.noise)
         if is_finite_number(peak) and peak > 0 and dip:
             status = "overlap"
@@ -181,8 +181,11 @@ class LineAnalyzer:
             misfit = math.sqrt(max(residual ** 2 - impact.noise ** 2, 0.0)) / peak \
                 if is_finite_number(residual) and is_finite_number(peak) and peak > 0 else math.nan
             limit = math.hypot(MISFIT_LIMIT, math.sqrt(MODEL_MARGIN) * self.lane_misfit(impact.lane))
-            shown = impact.noise > 0 and (misfit * peak / impact.noise) ** 2 \
+            # without noise (a clean signal: the detector's σ decays to 0) a misfit has no scatter: always shown
+            shown = not impact.noise > 0 or (misfit * peak / impact.noise) ** 2 \
                 > MISFIT_SD * math.sqrt(2.0 / max(own.window.size, 1))
+            # what the lane learns: a converged fit of an unclipped contact (a clipped top is not the force law's)
+            learnt = misfit if status == "ok" and shape.get("converged") else math.nan
             if misfit > limit and shown:  # converged or not: no single pulse fits
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
@@ -255,9 +258,9 @@ class LineAnalyzer:
                         reports[-1].update(status="overlap", message=(
                             f"a rebound landing on another fruit's contact, told apart by a joint fit of the pulses; "
                             f"its peak force is determined to ±{spread:.1%} only (at most ±{PIECE_PRECISION:.0%})"))
-            self._misfit_seen(impact.lane, misfit)
+            self._misfit_seen(impact.lane, learnt)
             return reports
-        self._misfit_seen(impact.lane, misfit)
+        self._misfit_seen(impact.lane, learnt)
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
             without_firmness(report)
             inside = own.window[impact.start_index - own.window_start:impact.end_index + 1 - own.window_start]
@@ -275,9 +278,8 @@ class LineAnalyzer:
         an overlap: never one fruit fitted through two).  ``rebounds``: which pieces are rebounds (``_rebounds``).
         Returns ``parts`` itself when nothing changed."""
         lane = parts[0][0].lane
-        if len(due) < 2 or not _may_split(parts[0][1], parts[0][0],
-                                          self._model_variance(lane, max(fit["peak_force"] for _, fit in parts),
-                                                               parts[0][0])):
+        highest = float(np.nanmax([fit["peak_force"] for _, fit in parts]))
+        if len(due) < 2 or not _may_split(parts[0][1], parts[0][0], self._model_variance(lane, highest, parts[0][0])):
             return parts  # the joint fit left only the noise (and what the lane's lone fruit leave)
         for k, ((piece, fit), rebound) in enumerate(zip(parts, rebounds)):
             if rebound:
