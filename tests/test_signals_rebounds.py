@@ -327,7 +327,7 @@ def test_two_fruit_whose_pulses_the_samples_cannot_separate_are_one_overlap(gap,
 def test_two_fruit_on_a_noise_free_signal_are_never_one_fruit():
     """A clean signal (a simulation, or a sensor whose noise is below its resolution: the detector's σ decays to 0)
     of two fruit 1.5 ms apart: one unimodal pulse that the force law misses by 2.7 % of its peak.  With no noise
-    that misfit has no scatter, so it always counts (``analysis.MISFIT_SD`` weighs a misfit against the noise's
+    that misfit has no scatter, so it always counts (``onepulse.MISFIT_SD`` weighs a misfit against the noise's
     χ² scatter; a review found the test switched off at σ = 0, and the two fruit graded as one).  Never one fruit
     fitted through both: an overlap, or two pieces."""
     a = impact()
@@ -381,7 +381,7 @@ def test_a_rebound_ended_by_the_next_fruits_landing_is_measured_and_stays_a_rebo
 def test_a_rebound_and_the_next_fruit_landing_together_are_told_apart(gap, seed):
     """The previous fruit's rebound is due (its flight 2 e V/g from its own measured e and the line's V) and the
     next fruit lands 2–3 ms from it: one smooth pulse that one force law fits within the misfit limit, but two
-    pulses fit it far better (rebounds.rebounds_due, analysis.SPLIT_GAIN), so it is split: the rebound is the
+    pulses fit it far better (rebounds.rebounds_due, onepulse.SPLIT_GAIN), so it is split: the rebound is the
     first fruit's (rebound_of), the next fruit a new one, graded from its own piece.  Tolerances from 20 seeds
     per gap (max seen in brackets): onsets 0.2 ms, the new fruit's peak 2 % (1.2 %: its piece is fixed to ±1 %,
     analysis.PIECE_PRECISION) and stiffness 10 % (8.5 %).  The rebound landing 2 ms after the next fruit, on its
@@ -422,7 +422,7 @@ def test_a_rebound_and_the_next_fruit_landing_within_a_millisecond_are_one_overl
 
 def test_a_fruit_alone_where_a_rebound_is_due_stays_one_fruit():
     """A fruit landing alone where the previous fruit's rebound is due (a pad caught that rebound): its single
-    fit leaves only the noise, so no joint fit is even tried (analysis._may_split), and it is one new fruit,
+    fit leaves only the noise, so no joint fit is even tried (onepulse.may_split), and it is one new fruit,
     peak within 1 % and stiffness within 3 % (the single-pulse precision of tests/test_signals_fit.py)."""
     a = impact()
     b = impact(mass=1.1 * MASS, restitution=0.5)

@@ -157,7 +157,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
     result, j = first, 0  # the impact's evaluation and its row there
     batch = None
     flattened = None
-    crushed = None  # the impact at which the board under the fruit crushed
+    crushed = False  # the board under the fruit has crushed: its spot stays so
     material_factor = float(first.columns["damping_factor"][0])
     if not math.isfinite(material_factor):
         material_factor = 0.0
@@ -173,8 +173,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             break
         if result.plastic_block is not None and result.plastic[j] and columns["permanent_deflection"] > 0.0:
             flattened = float(result.plastic_block[j, -1])  # the spot as this impact left it: R_p
-        if _crushed_board(result, j):
-            crushed = len(impacts)  # the board's flutes under the fruit collapsed at this impact
+        crushed = crushed or _crushed_board(result, j)
         rebound = columns["exit_velocity"]
         if rebound * rebound / (2.0 * STANDARD_GRAVITY) < rest_height or len(impacts) >= max_impacts:
             if len(impacts) >= max_impacts and rebound * rebound / (2.0 * STANDARD_GRAVITY) >= rest_height:
@@ -193,7 +192,7 @@ def drop(drop_height, *, max_impacts: int = MAX_IMPACTS, rest_height: float = RE
             next_row["yield_pressure"] = float(first.columns["yield_pressure"][0])
             next_row["stiffness"] = 4.0 / 3.0 * _contact_modulus(first) * math.sqrt(flattened)
             next_row["diameter"] = 2.0 * flattened
-        if crushed is not None:
+        if crushed:
             # the same spot of a crushed board: its flutes stay collapsed, so the fruit lands on the floor that
             # carried the force beyond the crush (rigid, as in the layer model), with none of the board's work
             for name in [name for name in next_row if name.startswith("surface")]:

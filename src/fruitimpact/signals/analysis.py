@@ -13,8 +13,9 @@ For each contact, in order, as soon as the detector emits it (nothing waits for 
    had before it crossed the threshold): two fruit a few milliseconds apart are two contacts, each
    measured on its own samples.
 2. **Raw indices** (``indices.impact_indices``).
-3. **Overlap.**  A contact whose force falls and rises again by more than ``OVERLAP_FRACTION`` of its
-   peak (``indices.second_pulse``), or that no single pulse fits (``split.MISFIT_LIMIT``), holds two fruit
+3. **Overlap** (``signals.onepulse``).  A contact whose force falls and rises again beyond the noise and
+   ``OVERLAP_FRACTION`` of its peak (``indices.second_pulse``), or that no single pulse fits as one fruit of
+   its lane does (``split.MISFIT_LIMIT``, ``onepulse.LaneMisfits``), holds two fruit
    (or a fruit and a rebound): fitted as two pulses (``signals.split``), each becomes its own contact;
    when that fails, one report with status ``overlap``, no firmness, no fit, no class.
 4. **Rebound or new fruit** (``signals.rebounds``): decided from the contacts before it, by the
@@ -48,42 +49,10 @@ from fruitimpact.signals.rebounds import (DAMPING_EXPONENT, HIDDEN_FRUIT_MIN, LA
 from fruitimpact.signals.settings import Analysis  # also this module's public name (defined beside the detector's settings)
 from fruitimpact.signals.reports import (FIRMNESS_KEYS, SUMMARY_KEYS, UNSPLIT, detector_status, is_finite_number,
                                         merge_fit, restated, shape_fit, without_firmness)
-from fruitimpact.signals.split import FITS, FITS_DUE, MISFIT_LIMIT, split_contact
+from fruitimpact.signals.onepulse import (SPLIT_GAIN, LaneMisfits, is_dip, may_split, misfit_limit, misfit_shown,
+                                          single_misfit, split_gain)
+from fruitimpact.signals.split import FITS, FITS_DUE, split_contact
 
-#: A second rise (or an earlier fall) larger than this share of the peak is a second fruit in the contact ...
-OVERLAP_FRACTION = 0.10
-#: ... when it is also beyond this many noise sd: one pulse's own noise makes the smoothed force rise again after
-#: its top by 1.4–1.6 σ at the median, 2.4–2.7 σ at p99 and 3.7 σ at most (tests/linegen.py's chain10, grades and
-#: noisy at 1 % and 3 % noise); 2 σ at 3 % noise is 12–14 % of a 35–40 N rebound's peak: before this bound,
-#: 219 contacts in 16 such recordings were reported as overlaps of pulses that were not there.  At 1 % noise
-#: every overlap whose dip exceeds 10 % of its peak lies beyond 4 σ, so nothing changes there.
-DIP_NOISE_SD = 4.0
-#: The single-pulse misfit counts only when the samples show it: its excess variance (rms² − σ²)/σ² beyond this
-#: many sd of its own scatter, √(2/n) over n samples (χ²/n of the noise alone).  A misfit of 2 % on a 35 N
-#: rebound under 2.4 N of noise is 0.1 σ², inside that scatter (0.14 σ² per sd at 100 samples).
-MISFIT_SD = 3.0
-#: A contact in which a rebound is due (``rebounds.rebounds_due``) but that one pulse fits is split only when two
-#: pulses fit it better by this much (χ² per sample, in noise variances; ``_split_gain``): over ~240 samples that
-#: is Δχ² ≈ 50 for 4 more parameters, far beyond chance.  Measured on the line scenarios of tests/linegen.py
-#: (every contact where a rebound was due and a split was found): 527 single fruit gained at most 0.08 (a second
-#: Hertz pulse cannot follow plate ringing or hum), 10 fruit and rebounds landing 0–1.5 ms apart gained
-#: 0.22–2.2.  Below it the contact stays one fruit.
-SPLIT_GAIN = 0.2
-#: What one fruit of a lane leaves of its own pulse beyond the noise when the force law is not exactly the fit's
-#: (an exponent of 1.3 where Hertz has 1.5, a fruit that is not a homogeneous sphere): its single-pulse misfit
-#: (excess rms over the peak force) is learnt per lane as the median of the last ``LANE_MISFITS_KEPT`` contacts'
-#: (a few fruit landing together do not move a median), once ``LANE_MISFITS_MIN`` are in.  Of that median, the
-#: part beyond ``HERTZ_LINE_MISFIT`` (in quadrature) is the force law's: up to it, Hertz's own pulses leave it
-#: through plate ringing, hum and drift, which no second pulse takes up (tests/linegen.py's eight scenarios: lane
-#: medians 0–0.2 %, 0.5 % on ``noisy``).  A second pulse fitted to such a fruit takes up the force law's misfit,
-#: not a second fruit: a split then has to gain, beyond ``SPLIT_GAIN``, ``MODEL_MARGIN`` times that share (1.5²:
-#: a lone fruit's own misfit reaches 1.2–1.5 times the lane's median), and ``split.MISFIT_LIMIT`` is widened by
-#: the same share.  Measured on tests/linegen.py's pulses with the force law's exponent at 1.3 (the same force at
-#: the fruit's deflection): lone fruit left 0.8–1.0 % of their peak at the median, and 364 of them in 16
-#: recordings (about 1,900 contacts) were reported as two pulses that could not be told apart; 18 now.  An
-#: exponent of 1.7 leaves 0.5 %, as much as ringing and hum do on ``noisy``: the misfit does not tell the two
-#: apart, and such a line still loses grades to overlaps (104 → 73; docs/signals.md).
-LANE_MISFITS_KEPT, LANE_MISFITS_MIN, MODEL_MARGIN, HERTZ_LINE_MISFIT = 15, 5, 2.25, 0.005
 #: At most this many earlier contacts whose rebound is due guide a joint fit (the latest first; their hypotheses
 #: share the ``split.FITS`` fits; on a line of 10 fruit/s with two rebounds each, 1–3 are due at once).
 MAX_DUE = 3
@@ -144,8 +113,8 @@ class LineAnalyzer:
         self._unmeasured: dict[int, list[tuple]] = {}
         #: per lane: the recent measured new fruit (the lot's typical pulse at the line's speed)
         self._fruit: dict[int, list[PulseSummary]] = {}
-        #: per lane: the single-pulse misfit (excess rms / peak force) of its recent contacts (``lane_misfit``)
-        self._misfits: dict[int, list[float]] = {}
+        #: per lane: the single-pulse misfit its recent contacts left (``onepulse.LaneMisfits``)
+        self._misfits = LaneMisfits()
         #: per lane: the number of the next contact (a detected impact holds one to three contacts)
         self._sequence: dict[int, int] = {}
         #: per lane: fruit reported while the lane has shown no sign of a rebound; None once it has (``_quiet_fruit``)
@@ -169,24 +138,20 @@ class LineAnalyzer:
         peak = report["peak_force"]
         second = second_pulse(own)
         shape = None
-        misfit = learnt = math.nan  # the single pulse's; the lane learns it when the contact is decided
-        dip = second > max(OVERLAP_FRACTION * peak, DIP_NOISE_SD * impact.noise)
-        if is_finite_number(peak) and peak > 0 and dip:
+        learnt = math.nan  # the single pulse's misfit; the lane learns it when the contact is decided
+        dip = is_dip(second, peak, impact.noise)
+        if dip:
             status = "overlap"
             message = (f"two pulses in one contact: the force falls and rises again by {second:.3g} N "
                        f"({second / peak:.0%} of the peak): two fruit, or a fruit and a rebound; no firmness")
         elif status in ("ok", "clipped"):
             shape = shape_fit(own, analysis)
-            residual = shape.get("fit_residual", math.nan)
-            misfit = math.sqrt(max(residual ** 2 - impact.noise ** 2, 0.0)) / peak \
-                if is_finite_number(residual) and is_finite_number(peak) and peak > 0 else math.nan
-            limit = math.hypot(MISFIT_LIMIT, math.sqrt(MODEL_MARGIN) * self.lane_misfit(impact.lane))
-            # without noise (a clean signal: the detector's σ decays to 0) a misfit has no scatter: always shown
-            shown = not impact.noise > 0 or (misfit * peak / impact.noise) ** 2 \
-                > MISFIT_SD * math.sqrt(2.0 / max(own.window.size, 1))
+            misfit = single_misfit(shape.get("fit_residual", math.nan), impact.noise, peak)
+            limit = misfit_limit(self._misfits.share(impact.lane))
             # what the lane learns: a converged fit of an unclipped contact (a clipped top is not the force law's)
             learnt = misfit if status == "ok" and shape.get("converged") else math.nan
-            if misfit > limit and shown:  # converged or not: no single pulse fits
+            if misfit > limit and misfit_shown(misfit, peak, impact.noise, own.window.size):
+                # converged or not: no single pulse fits
                 status = "overlap"
                 message = (f"not one pulse: the force law misses it by {misfit:.1%} of its peak beyond the noise "
                            f"(one fruit: at most {limit:.1%}): two fruit landing together; no firmness")
@@ -202,10 +167,11 @@ class LineAnalyzer:
         if status == "overlap" and not (impact.truncated or impact.overlong or impact.clipped):
             parts = self._split(own, due, FITS, dip=dip)
         elif status == "ok" and due and shape is not None and shape.get("converged") \
-                and _may_split(shape, own, self._model_variance(impact.lane, peak, own)):
+                and may_split(shape, impact.noise, model := self._misfits.model_variance(impact.lane, peak,
+                                                                                          impact.noise)):
             parts = self._split(own, due, FITS_DUE, dip=False)
-            gain = _split_gain(shape, parts, own) if parts is not None else 0.0
-            if gain < SPLIT_GAIN + self._model_variance(impact.lane, peak, own):
+            gain = split_gain(shape, parts, impact.noise) if parts is not None else 0.0
+            if gain < SPLIT_GAIN + model:
                 parts = None  # one pulse fits as well, or no better than the lane's lone fruit: one fruit
             elif not any(flags := self._rebounds(parts, impact.noise)):
                 # two pulses, but neither is the rebound that was due: landing within a fraction of a
@@ -258,9 +224,9 @@ class LineAnalyzer:
                         reports[-1].update(status="overlap", message=(
                             f"a rebound landing on another fruit's contact, told apart by a joint fit of the pulses; "
                             f"its peak force is determined to ±{spread:.1%} only (at most ±{PIECE_PRECISION:.0%})"))
-            self._misfit_seen(impact.lane, learnt)
+            self._misfits.seen(impact.lane, learnt)
             return reports
-        self._misfit_seen(impact.lane, learnt)
+        self._misfits.seen(impact.lane, learnt)
         if status == "overlap":  # the indices of one pulse do not apply: the contact as detected
             without_firmness(report)
             inside = own.window[impact.start_index - own.window_start:impact.end_index + 1 - own.window_start]
@@ -277,46 +243,22 @@ class LineAnalyzer:
         rebound becomes two; one that two pulses fit better but holds none is marked ``HOLDS_TWO`` (reported as
         an overlap: never one fruit fitted through two).  ``rebounds``: which pieces are rebounds (``_rebounds``).
         Returns ``parts`` itself when nothing changed."""
-        lane = parts[0][0].lane
+        lane, noise = parts[0][0].lane, parts[0][0].noise
         highest = float(np.nanmax([fit["peak_force"] for _, fit in parts]))
-        if len(due) < 2 or not _may_split(parts[0][1], parts[0][0], self._model_variance(lane, highest, parts[0][0])):
+        if len(due) < 2 or not may_split(parts[0][1], noise, self._misfits.model_variance(lane, highest, noise)):
             return parts  # the joint fit left only the noise (and what the lane's lone fruit leave)
         for k, ((piece, fit), rebound) in enumerate(zip(parts, rebounds)):
             if rebound:
                 continue  # a rebound of its own: the third pulse is in the other piece
             again = self._split(piece, due, FITS_AGAIN, dip=False)
-            if again is None or _split_gain(fit, again, piece) < SPLIT_GAIN + self._model_variance(
-                    lane, fit["peak_force"], piece):
+            if again is None or split_gain(fit, again, piece.noise) < SPLIT_GAIN + self._misfits.model_variance(
+                    lane, fit["peak_force"], piece.noise):
                 continue
             flags = self._rebounds(again, piece.noise)
             if not any(flags) or _imprecise(again, flags) is not None:
                 return [*parts[:k], (piece, {**fit, HOLDS_TWO: True}), *parts[k + 1:]]
             return sorted([*parts[:k], *again, *parts[k + 1:]], key=lambda part: part[1]["start_time"])
         return parts
-
-    def lane_misfit(self, lane: int) -> float:
-        """The single-pulse misfit that the force law leaves on one fruit of ``lane`` (excess rms over the peak
-        force, ``LANE_MISFITS_KEPT``): the median of its recent contacts' beyond ``HERTZ_LINE_MISFIT`` (in
-        quadrature), 0 until ``LANE_MISFITS_MIN`` are in."""
-        seen = self._misfits.get(lane, [])
-        if len(seen) < LANE_MISFITS_MIN:
-            return 0.0
-        return math.sqrt(max(float(np.median(seen)) ** 2 - HERTZ_LINE_MISFIT ** 2, 0.0))
-
-    def _misfit_seen(self, lane: int, misfit: float) -> None:
-        if not is_finite_number(misfit):
-            return
-        seen = self._misfits.setdefault(lane, [])
-        seen.append(misfit)
-        del seen[:-LANE_MISFITS_KEPT]
-
-    def _model_variance(self, lane: int, peak: float, impact: DetectedImpact) -> float:
-        """What a split must gain beyond ``SPLIT_GAIN`` on ``lane`` for a contact of peak ``peak`` [N], in noise
-        variances per sample (``MODEL_MARGIN``): 0 on a lane whose fruit the force law fits to the noise."""
-        share = self.lane_misfit(lane)
-        if not (share > 0 and impact.noise > 0 and is_finite_number(peak)):
-            return 0.0
-        return MODEL_MARGIN * (share * peak / impact.noise) ** 2
 
     def _not_a_fruit(self, lane: int, sequence: int) -> None:
         """Contact ``sequence`` of ``lane``, taken for a fruit, was a rebound (``rebound_of_a_rebound``): its grade
@@ -810,15 +752,6 @@ def isolated(impact: DetectedImpact) -> DetectedImpact:
     return dataclasses.replace(impact, window_start=lo, window=window)
 
 
-def _split_gain(shape: dict, parts, impact: DetectedImpact) -> float:
-    """How much better two pulses fit the contact's window than one: the drop of χ² per sample, in units of
-    the noise variance ((rms₁² − rms₂²)/σ²; both fits are over the same samples)."""
-    one, two = shape.get("fit_residual", math.nan), parts[0][1].get("fit_residual", math.nan)
-    if not (is_finite_number(one) and is_finite_number(two) and impact.noise > 0):
-        return 0.0
-    return (one ** 2 - two ** 2) / impact.noise ** 2
-
-
 def _imprecise(parts, rebounds) -> float | None:
     """The largest relative standard error of the peak force of a piece that is no rebound (``rebounds``: one flag
     per piece) when it exceeds ``PIECE_PRECISION``, else None: that fruit's amplitude is then not fixed by the
@@ -832,19 +765,6 @@ def _imprecise(parts, rebounds) -> float | None:
 def _relative_peak_error(fit: dict) -> float:
     """The joint fit's relative standard error of a piece's peak force (inf when it has none)."""
     return fit.get("peak_force_stderr", math.inf) / fit["peak_force"] if fit.get("peak_force") else math.inf
-
-
-def _may_split(shape: dict, impact: DetectedImpact, model: float = 0.0) -> bool:
-    """Whether two pulses might fit the contact better than one by ``SPLIT_GAIN`` (and ``model``, the lane's
-    lone-fruit share, ``LineAnalyzer._model_variance``), a screen before the joint fits (each costs ~1 ms): a
-    second pulse only removes structure, not the noise, so a single fit whose residual is below (0.95 +
-    ``SPLIT_GAIN`` + model) σ² leaves little for it.  Statistical, not a bound (χ²/n scatters by √(2/n),
-    ~0.09 over a contact): on the line scenarios of tests/linegen.py it skipped 93 % of the single fruit where a
-    rebound was due and none of the fruit and rebounds that were then told apart (their single fits left
-    ≥ 1.2 σ²)."""
-    residual = shape.get("fit_residual", math.nan)
-    return is_finite_number(residual) and impact.noise > 0 \
-        and residual ** 2 >= (0.95 + SPLIT_GAIN + model) * impact.noise ** 2
 
 
 def _score(verdict: Verdict) -> float:
