@@ -83,13 +83,14 @@ def merge_fit(report: dict, result: dict) -> None:
         if key in result and result.get("converged") and is_finite_number(result[key]):
             report[f"raw_{key}"] = report.get(key)
             report[key] = result[key]
+    converged = bool(result.get("converged", False))
     for key in FIT_KEYS:
-        if key in result:
-            report[key] = result[key]
-            report[f"{key}_stderr"] = result.get(f"{key}_stderr", math.nan)
+        if key in result:  # a fit that did not converge measured nothing: its last iterate is not a value
+            report[key] = result[key] if converged else math.nan
+            report[f"{key}_stderr"] = result.get(f"{key}_stderr", math.nan) if converged else math.nan
     report["fit_residual"] = result.get("fit_residual", math.nan)
     report["fit_residual_relative"] = result.get("fit_residual_relative", math.nan)
-    report["fit_converged"] = bool(result.get("converged", False))
+    report["fit_converged"] = converged
     report["fit_message"] = result.get("message", "")
     report["_fit"] = result  # the whole fit (for figures); not part of the JSON
 
