@@ -29,7 +29,8 @@ through a rebound they carry, i.e. one pulse fitted through both, and how many o
 ``rebound_ambiguous``; lone fruit flagged that way).
 ``--variants``: the same at other settings of the generator (``VARIANTS``: flights ±20 %, spin to 15 %, 10 kHz,
 twice the noise, 3 and 6 cm drops, a restitution that does not change with speed, fruit whose force law is not
-Hertz's: δ^1.3 and δ^1.7), at seeds 1,2 or ``--seeds``.
+Hertz's: δ^1.3 and δ^1.7, a piezoelectric sensor's discharge, a 2 kHz anti-alias filter, a 12-bit ADC), at seeds 1,2
+or ``--seeds``.
 
 The analysis run is whatever ``fruitimpact`` the current interpreter imports (PYTHONPATH is passed on).
 """
@@ -169,7 +170,9 @@ def _seeds(text: str) -> list[int]:
 #: to the goals.  Each (scenario, changes): flights off by ±20 % (the issue's upper bound for spin and off-axis
 #: bounces), spin taking up to 15 % of the rebound's speed, a 10 kHz acquisition, twice the noise, drops of 3 and
 #: 6 cm (the issue's 30–60 mm), and fruit whose restitution is the same at every speed (``linegen.DAMPING_LAWS``:
-#: Lankarani–Nikravesh, Flores), where the Hunt–Crossley fruit of the scenarios come back livelier.
+#: Lankarani–Nikravesh, Flores), where the Hunt–Crossley fruit of the scenarios come back livelier; fruit whose
+#: force law is not Hertz's; and the stages of the impact-sensor note's sensor chain the scenarios leave out: a
+#: piezoelectric chain's discharge (τ measured by the analysis, or told), a 2 kHz anti-alias low-pass, a 12-bit ADC.
 VARIANTS = {
     "chain10/flight±20%": ("chain10", {"flight_jitter": 0.20}),
     "chain10/spin≤15%": ("chain10", {"spin_loss": (0.0, 0.15)}),
@@ -185,6 +188,12 @@ VARIANTS = {
     "pad/n=1.3": ("pad", {"force_exponent": 1.3}),
     "chain10/n=1.3": ("chain10", {"force_exponent": 1.3}),
     "lanes4/n=1.7": ("lanes4", {"force_exponent": 1.7}),
+    "pad/piezo 0.1 s": ("pad", {"discharge_time": 0.1, "discharge_told": False}),
+    "chain10/piezo 0.1 s": ("chain10", {"discharge_time": 0.1, "discharge_told": False}),
+    "lanes4/piezo 0.3 s": ("lanes4", {"discharge_time": 0.3, "discharge_told": False}),
+    "grades/piezo 0.1 s told": ("grades", {"discharge_time": 0.1}),
+    "chain7/anti-alias 2 kHz": ("chain7", {"antialias_order": 4, "antialias_cutoff": 0.1}),
+    "close/12-bit ADC": ("close", {"adc_bits": 12}),
 }
 
 
@@ -273,8 +282,8 @@ def main(argv=None) -> int:
                                                          "a line per recording and the totals")
     parser.add_argument("--variants", action="store_true",
                         help="other settings of the generator (VARIANTS: flights ±20 %%, spin to 15 %%, 10 kHz, "
-                             "noise ×2, 3 and 6 cm drops, constant-restitution damping) at seeds 1,2 (or "
-                             "--seeds): a line per recording")
+                             "noise ×2, 3 and 6 cm drops, constant-restitution damping, force laws, sensor "
+                             "chains) at seeds 1,2 (or --seeds): a line per recording")
     args = parser.parse_args(argv)
     names = args.scenarios.split(",") if args.scenarios else list(lg.SCENARIOS)
     unknown = [n for n in names if n not in lg.SCENARIOS]

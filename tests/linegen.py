@@ -47,10 +47,16 @@ Fruit (ranges chosen from the literature on apples and pears; each kind is a ``F
 Sensor chain (in the physical order)
     sum of the lane's contact forces on a grid ``oversample`` × finer than the rate → plate/transducer resonance
     H(s) = ωn² / (s² + 2 ζ ωn s + ωn²) (DC gain 1), discretised by the bilinear transform prewarped at ωn
-    (derived in ``resonance_coefficients``) → sampled at the rate (every ``oversample``-th point) → baseline
+    (derived in ``resonance_coefficients``) → optional piezo discharge, the first-order high-pass s/(s + 1/τ) of a
+    charge amplifier or IEPE sensor (``discharge_time`` τ; ``discharge_coefficients``) → optional Butterworth
+    anti-alias low-pass (``antialias_order`` at ``antialias_cutoff`` × the rate) → sampled at the rate (every
+    ``oversample``-th point) → baseline
     offset + drift (linear + random walk, ~±``drift`` N over the recording) + mains hum (fundamental within
     ±0.02 Hz of 50/60 Hz, 3rd harmonic at 30 % of it; ``hum_level`` × the median primary peak) + white noise
-    (σ = ``noise`` × the median primary peak) → float32 (the acquisition's word).
+    (σ = ``noise`` × the median primary peak) → optional ADC quantisation over ±``adc_range`` with clipping there
+    (``adc_bits``) → float32 (the acquisition's word).  The order and the optional stages follow the impact-sensor
+    background note's sensor chain (§3.1); its analysis (``_analysis``) is told the discharge time constant, as a
+    user reads it from the sensor's data sheet.
 
 Writers
     ``f32``: raw little-endian float32, lanes interleaved sample-major (analyze needs ``--rate R --lanes K``);
@@ -74,7 +80,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.signal import lfilter
+from scipy.signal import butter, lfilter, sosfilt
 
 #: Standard gravity [m/s²].
 G = 9.80665
@@ -275,6 +281,12 @@ class Scenario:
     offset: float = 2.0                         # baseline offset, uniform ± [N]
     plate_frequency: float = 2500.0             # resonance [Hz]
     plate_damping: float = 0.05                 # ζ [-]
+    discharge_time: float = 0.0                 # piezo chain's time constant τ [s] (first-order high-pass; 0: none)
+    discharge_told: bool = True                 # the analysis is told τ (the data sheet) or must measure it
+    antialias_order: int = 0                    # Butterworth anti-alias low-pass order (0: none)
+    antialias_cutoff: float = 0.25              # its cut-off / the sample rate [-]
+    adc_bits: int = 0                           # ADC word (0: none); quantised over ±adc_range, clipped there
+    adc_range: float = 250.0                    # [N]
     oversample: int = 8                         # analogue grid / sample rate
     quiet: float = 0.15                         # quiet signal before the first slot [s]
     thresholds: tuple[float, ...] = THRESHOLDS  # class thresholds by modulus [Pa]
@@ -436,6 +448,15 @@ def resonance_coefficients(frequency: float, damping: float, rate: float) -> tup
     return b / a[0], a / a[0]
 
 
+def discharge_coefficients(time_constant: float, rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """(b, a) of a piezo chain's discharge H(s) = s / (s + 1/τ), a first-order high-pass, by the bilinear
+    transform: s = 2 rate (z − 1)/(z + 1) gives b = (1, −1)·g, a = (1, −(1 − q)/(1 + q)) with q = 1/(2 τ rate)
+    and g = 1/(1 + q).  At DC (z = 1) b sums to 0: a static force decays with τ, and after a contact of impulse I the
+    output undershoots by ≈ I/τ (``impact-sensors`` background note, sensor chain stage 3)."""
+    q = 1.0 / (2.0 * time_constant * rate)
+    return np.array([1.0, -1.0]) / (1.0 + q), np.array([1.0, -(1.0 - q) / (1.0 + q)])
+
+
 def generate(scenario: Scenario | str, size: int | None = None, *, clean: bool = False):
     """(samples × lanes float32 recording [N], truth dict) of a scenario with ``size`` fruit per lane.
 
@@ -462,7 +483,13 @@ def generate(scenario: Scenario | str, size: int | None = None, *, clean: bool =
         j = np.arange(j0, j1)
         force[j, c["lane"]] += c["pulse"].force(j / fine - c["start_time"])
     b, a = resonance_coefficients(scenario.plate_frequency, scenario.plate_damping, fine)
-    sensed = lfilter(b, a, force, axis=0)[::scenario.oversample]
+    sensed = lfilter(b, a, force, axis=0)
+    if scenario.discharge_time > 0.0:
+        sensed = lfilter(*discharge_coefficients(scenario.discharge_time, fine), sensed, axis=0)
+    if scenario.antialias_order > 0:
+        sensed = sosfilt(butter(scenario.antialias_order, scenario.antialias_cutoff * rate, fs=fine, output="sos"),
+                         sensed, axis=0)
+    sensed = sensed[::scenario.oversample]
     t = np.arange(n) / rate
     peaks = [c["pulse"].peak_force for c in contacts if not c["is_rebound"]]
     typical = float(np.median(peaks))
@@ -484,6 +511,9 @@ def generate(scenario: Scenario | str, size: int | None = None, *, clean: bool =
             sensor["offsets"].append(offset)
             sensor["drift_end"].append(float(baseline[-1] - baseline[0]))
         sensor.update(hum_frequency=hum_f, hum_phase=phase)
+    if scenario.adc_bits > 0:
+        lsb = 2.0 * scenario.adc_range / 2 ** scenario.adc_bits
+        sensed = np.clip(np.round(sensed / lsb) * lsb, -scenario.adc_range, scenario.adc_range - lsb)
     recording = sensed.astype(np.float32)
     index = {id(c): c["index"] for c in contacts}
     truth_contacts = []
@@ -525,7 +555,8 @@ def generate(scenario: Scenario | str, size: int | None = None, *, clean: bool =
 def _analysis(scenario: Scenario, fruits: list[dict]) -> dict:
     """What a user of the line knows and tells ``analyze``."""
     info = dict(format=scenario.fmt, rate=scenario.rate, lanes=scenario.lanes, drop_height=scenario.drop_height,
-                hum=scenario.hum_frequency, grading=scenario.grading)
+                hum=scenario.hum_frequency, grading=scenario.grading,
+                discharge_time=(scenario.discharge_time or None) if scenario.discharge_told else None)
     if scenario.grading:
         kind = scenario.kinds[0][0]
         info.update(diameter=kind.diameter, poisson=kind.poisson[0], thresholds=list(scenario.thresholds),
@@ -538,6 +569,8 @@ def analyze_options(truth: dict) -> list[str]:
     drop height and the hum, ``--rate/--lanes`` for raw files, the grading options for a grading lot."""
     a = truth["analysis"]
     options = ["--json", "--fit", "--drop-height", f"{a['drop_height'] * 1000:g}mm", "--hum", f"{a['hum']:g}"]
+    if a.get("discharge_time"):  # the sensor's data sheet gives it
+        options += ["--discharge-time", f"{a['discharge_time']:g}s"]
     if a["format"] in ("f32", "npy"):
         options += ["--rate", f"{a['rate']:g}"]
     if a["format"] == "f32":

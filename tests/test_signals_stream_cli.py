@@ -73,6 +73,11 @@ def test_stream_refuses_bad_options_in_one_line(cli):
     assert "--format" in cli.error("stream", "--rate", "20000", "--format", "csv")
     assert "--listen" in cli.error("stream", "--rate", "20000", "--listen", "70000")
     assert "exactly one of" in cli.error("stream", "--rate", "20000", "--fit")
+    # a discharge time constant: auto, none or at least 10 ms (faster chains keep too little of a contact)
+    for bad in ("5ms", "-1s", "nan", "fast", "3kg"):
+        line = cli.error("stream", "--rate", "20000", "--discharge-time", bad)
+        assert line.startswith("fruitimpact stream: error: argument --discharge-time: must be auto, none or a time "
+                               "constant in [0.01, 1e+06] s"), line
 
 
 def test_raw_float32_fed_as_text_is_refused_early_in_one_line():

@@ -37,6 +37,10 @@ def add_analysis_options(parser) -> None:
     det = parser.add_argument_group("detection (defaults suit fruit on a force plate at 10-50 kHz)")
     det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic")
     det.add_argument("--lowpass", metavar="HZ", help="causal Butterworth low-pass (order 4) at this frequency")
+    det.add_argument("--discharge-time", metavar="S",
+                     help="a piezoelectric sensor chain's discharge time constant (data sheet; >= 10 ms): the force "
+                          "its high-pass took away is restored; auto (default): measured on each lane's contacts and "
+                          "restored where it shows; none: the sensor holds a static force (strain gauge)")
     det.add_argument("--rebound-window", metavar="S",
                      help="longest rebound flight considered; 0: no rebound detection (default 1.25 x 2V/g + 10 ms "
                           "with the velocity or drop height, else 0.3 s). A contact is a rebound only when its flight, "

@@ -130,7 +130,15 @@ class LineAnalyzer:
 
     def reports(self, impact: DetectedImpact) -> list[dict]:
         """The dicts of the contacts in one detected impact, in time order (SI; ``public(report)`` is the
-        JSON object): one, or two or three when fruit landing together were told apart (``signals.split``)."""
+        JSON object): one, or two or three when fruit landing together were told apart (``signals.split``).
+        Each names the τ of the sensor's discharge restored in its window (``discharge_time`` [s], None when
+        none: ``signals.detect`` step 1b)."""
+        reports = self._reports(impact)
+        for report in reports:
+            report["discharge_time"] = impact.discharge_time
+        return reports
+
+    def _reports(self, impact: DetectedImpact) -> list[dict]:
         analysis = self.analysis
         own = isolated(impact)
         report = impact_indices(own, analysis.rate)

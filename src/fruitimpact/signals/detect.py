@@ -12,6 +12,14 @@ Per sample and lane, in this order:
 
 1. **Clipping**: the raw sample at or beyond ``clip_low``/``clip_high`` marks the impact in progress
    ``clipped``.
+1b. **Discharge restoration** (optional, ``discharge_time`` τ given): a piezoelectric chain (quartz sensor and
+   charge amplifier, or IEPE) is a first-order high-pass, dy/dt = dx/dt − y/τ, so a contact of impulse I droops
+   by up to I/τ and the signal undershoots by ≈ I/τ after it (a few % of the peak at τ = 0.1 s: the fitted
+   stiffness was ~10 % off in the scorecard's lines).  Its inverse is x = y + (1/τ) ∫ y dt; the integral is the
+   trapezoidal sum of the raw samples, leaking with ``DISCHARGE_LEAK`` · τ so that the acquisition's own offset
+   stays bounded (the chain and its inverse together are then a high-pass of time constant ``DISCHARGE_LEAK`` ·
+   τ, whose droop over a contact is a hundredth of the sensor's; the offset comes out ``DISCHARGE_LEAK`` + 1
+   times larger and is the baseline the next stage removes), started in its steady state for the first sample.
 2. **Low-pass** (optional): a causal Butterworth of ``lowpass_order`` at ``lowpass_cutoff``, a cascade
    of biquads designed here (bilinear transform with prewarping; no SciPy at run time), started in
    its steady state for the first sample.
@@ -79,7 +87,7 @@ import numpy as np
 from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.filters import butterworth_sos, solve_small
-from fruitimpact.signals.settings import DetectorSettings, at_rate, check_rate
+from fruitimpact.signals.settings import MIN_DISCHARGE_TIME, DetectorSettings, at_rate, check_rate
 
 __all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
 
@@ -135,6 +143,9 @@ class DetectedImpact:
     emitted_at : int
         Samples consumed by the detector when the impact was emitted (its latency is
         emitted_at − 1 − end_index samples).
+    discharge_time : float or None
+        τ [s] of the sensor chain's discharge restored in the lane when the impact was emitted (given, or
+        measured on the lane's contacts: step 1b); None when nothing was restored.
     """
 
     lane: int
@@ -154,6 +165,7 @@ class DetectedImpact:
     window_start: int
     window: np.ndarray
     emitted_at: int
+    discharge_time: float | None = None
 
     __hash__ = None
 
@@ -175,18 +187,46 @@ class DetectedImpact:
         return self.window_start + self.window.shape[0]
 
 
+#: The discharge restoration's leak, in units of the sensor's time constant τ (step 1b of the module docstring).
+DISCHARGE_LEAK = 100.0
+#: The leak [s] of the integral when the discharge is measured (τ not given): 100 times the longest τ a line's
+#: contacts show (~1 s: beyond it the undershoot of one contact is within its noise).
+DISCHARGE_AUTO_LEAK = 100.0
+#: The longest τ [s] restored when measured: a slower discharge droops a contact by < 1e-3 of its impulse (and
+#: on a noise-free signal any residual would otherwise count as shown).
+DISCHARGE_LONGEST = 10.0
+#: Measurements of the discharge a lane keeps (its last lone contacts').
+DISCHARGE_KEPT = 31
+#: The measured discharge is restored when the median of those exceeds this many of its standard errors.
+DISCHARGE_SHOWN = 5.0
+#: The samples after a contact that measure its undershoot start this long after its end [s] (past the pulse's
+#: tail below the offset threshold).
+DISCHARGE_MARGIN = 0.5e-3
+#: Fewest samples before the contact's foot and after that margin for a measurement.
+DISCHARGE_MIN_SAMPLES = 5
+#: Once restored, the gain stays while the median exceeds this many standard errors (hysteresis).
+DISCHARGE_HELD = 2.0
+#: 1/√(2/π): the standard error of a median over that of a mean, for normal scatter.
+MEDIAN_SE = 1.2533141373155001
+
 # ---------------------------------------------------------------------------------------------------------
 # State layout (per lane).  Floats in F, integers in I; the FIFO of ended impacts waiting for emission
 # follows the fixed fields (FIFO_F floats and FIFO_I integers per slot).
 
 F_B, F_SIG, F_PC, F_PS, F_PEAK, F_CB, F_CSIG, F_THROFF, F_D, F_CD = range(10)
 F_HUM = 10                      # a_k, d_k for up to 4 harmonics
-F_FIFO = F_HUM + 8
+# the discharge restoration (step 1b): its leaky integral [N·samples], the last raw sample, the gain g [1/samples],
+# the offset that keeps the restored signal continuous where g changes [N], and the lane's last DISCHARGE_KEPT
+# measurements of the gain (values, then their standard errors)
+F_DIS, F_DPREV, F_DGAIN, F_DOFF = F_HUM + 8, F_HUM + 9, F_HUM + 10, F_HUM + 11
+F_DRING = F_HUM + 12
+F_DRSE = F_DRING + DISCHARGE_KEPT
+F_FIFO = F_DRSE + DISCHARGE_KEPT
 FIFO_F = 4                      # peak value, baseline, noise, baseline slope
 P_PEAK, P_B, P_SIG, P_D = range(4)
 
-I_COUNT, I_STATE, I_WARMN, I_START, I_PEAKI, I_LAST, I_BELOW, I_CLIP, I_SEQ, I_NPEND, I_HEAD, I_PREV = range(12)
-I_FIFO = 12
+I_COUNT, I_STATE, I_WARMN, I_START, I_PEAKI, I_LAST, I_BELOW, I_CLIP, I_SEQ, I_NPEND, I_HEAD, I_PREV, I_DN = range(13)
+I_FIFO = 13
 FIFO_I = 9
 Q_START, Q_END, Q_PEAKI, Q_SEQ, Q_PREV, Q_CLIP, Q_TRUNC, Q_LONG, Q_EMIT = range(9)
 
@@ -196,13 +236,15 @@ S_WARM, S_QUIET, S_IN = 0, 1, 2
 O_LANE, O_SEQ, O_START, O_END, O_PEAKI, O_PREV, O_NEXT, O_CLIP, O_TRUNC, O_LONG, O_WSTART, O_WLEN, \
     O_WOFF, O_EMIT = range(14)
 N_OI = 14
-N_OF = 4  # peak value, baseline, noise, baseline slope per sample
+N_OF = 5  # peak value, baseline, noise, baseline slope per sample, discharge gain per sample
 
 # Parameters
-PF_AB, PF_AS, PF_KON, PF_KOFF, PF_FLOORON, PF_FLOOROFF, PF_G, PF_CW, PF_SW, PF_CLIPLO, PF_CLIPHI, PF_AD = range(12)
-N_PF = 12
-PI_HOLD, PI_MINLEN, PI_MAXLEN, PI_PRE, PI_POST, PI_WARMN, PI_L, PI_FIFO, PI_NSEC, PI_NH, PI_MAXWIN = range(11)
-N_PI = 11
+PF_AB, PF_AS, PF_KON, PF_KOFF, PF_FLOORON, PF_FLOOROFF, PF_G, PF_CW, PF_SW, PF_CLIPLO, PF_CLIPHI, PF_AD, \
+    PF_DGAIN, PF_DLEAK, PF_DAUTO, PF_DCAP, PF_DFLOOR = range(17)
+N_PF = 17
+PI_HOLD, PI_MINLEN, PI_MAXLEN, PI_PRE, PI_POST, PI_WARMN, PI_L, PI_FIFO, PI_NSEC, PI_NH, PI_MAXWIN, \
+    PI_DMARGIN = range(12)
+N_PI = 12
 
 #: E[min(|Z|, 3)] for a standard normal Z: the clipped mean absolute deviation of unit noise.
 CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / math.sqrt(2))
@@ -319,7 +361,63 @@ def _finish(lane, end, truncated, overlong, F, I, IP):
 
 
 @nb.njit(**_JIT)
-def _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt):
+def _measure_discharge(lane, F, I, PF, IP, OW, off, ws, we, start, end, peak, sigma):
+    """Step 1b's measurement on one lone contact's window OW[off:off + we − ws + 1] (module docstring): the gain
+    still missing, from the undershoot after the contact against the window's running integral; the lane's gain
+    becomes the median of its last ``DISCHARGE_KEPT`` measurements where shown, and the restored signal is kept
+    continuous where the gain changes.  True when the gain changed (and the window with it)."""
+    foot = int(math.ceil(0.3 * max(peak - start, 0))) + 2
+    n_pre = start - foot - ws
+    first = end + 1 + IP[PI_DMARGIN]
+    n_post = we - first + 1
+    if n_pre < DISCHARGE_MIN_SAMPLES or n_post < DISCHARGE_MIN_SAMPLES or not sigma > 0.0:
+        return False
+    pre = 0.0
+    for idx in range(n_pre):
+        pre += OW[off + idx]
+    pre /= n_pre
+    # the running trapezoidal integral of the window less its level before the contact, and the mean of the
+    # window and of that integral after the contact
+    integral = np.zeros(we - ws + 1)
+    integral_post = 0.0
+    level_post = 0.0
+    for idx in range(1, we - ws + 1):
+        value = OW[off + idx] - pre
+        integral[idx] = integral[idx - 1] + 0.5 * (value + OW[off + idx - 1] - pre)
+        if ws + idx >= first:
+            integral_post += integral[idx]
+            level_post += value
+    integral_post /= n_post
+    level_post /= n_post
+    if not integral_post > 0.0:
+        return False
+    missing = -level_post / integral_post
+    error = sigma * math.sqrt(1.0 / n_post + 1.0 / n_pre) / integral_post
+    count = I[lane, I_DN]
+    slot = count % DISCHARGE_KEPT
+    F[lane, F_DRING + slot] = F[lane, F_DGAIN] + missing
+    F[lane, F_DRSE + slot] = error
+    count += 1
+    I[lane, I_DN] = count
+    n = min(count, DISCHARGE_KEPT)
+    median = np.median(F[lane, F_DRING:F_DRING + n])
+    spread = MEDIAN_SE * np.median(F[lane, F_DRSE:F_DRSE + n]) / math.sqrt(n)
+    # hysteresis: a gain restored stays while its median is above DISCHARGE_HELD errors (no flicker at the edge)
+    shown = DISCHARGE_SHOWN if F[lane, F_DGAIN] == 0.0 else DISCHARGE_HELD
+    gain = min(median, PF[PF_DCAP]) if median > shown * spread and median > PF[PF_DFLOOR] else 0.0
+    change = gain - F[lane, F_DGAIN]
+    F[lane, F_DOFF] -= change * F[lane, F_DIS]
+    F[lane, F_DGAIN] = gain
+    if change != 0.0:
+        # this window was taken with the old gain: restore the change in it too (its pre-contact level is that
+        # of a lone contact, so the window's own inverse holds), and the lane's first contact is restored as well
+        for idx in range(1, we - ws + 1):
+            OW[off + idx] += change * integral[idx]
+    return change != 0.0
+
+
+@nb.njit(**_JIT)
+def _emit_head(lane, gi, F, I, R, PF, IP, OF, OI, OW, cnt):
     """Emit the oldest queued impact of the lane after sample ``gi`` (window cut at gi), with the onset of
     the next impact of the lane when it began inside the window."""
     fifo = IP[PI_FIFO]
@@ -348,10 +446,22 @@ def _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt):
     off = cnt[1]
     for idx in range(ws, we + 1):
         OW[off + idx - ws] = R[lane, idx % L] - (b + d * (idx - start))
+    if PF[PF_DAUTO] > 0.0 and nxt < 0 and I[lane, q + Q_CLIP] == 0 and I[lane, q + Q_TRUNC] == 0 \
+            and I[lane, q + Q_LONG] == 0 and I[lane, q + Q_PREV] + IP[PI_POST] < ws \
+            and _measure_discharge(lane, F, I, PF, IP, OW, off, ws, we, start, end, I[lane, q + Q_PEAKI],
+                                   F[lane, f + P_SIG]):
+        # the window was restored with the new gain: its peak taken again
+        top = start
+        for idx in range(start, end + 1):
+            if OW[off + idx - ws] > OW[off + top - ws]:
+                top = idx
+        I[lane, q + Q_PEAKI] = top
+        F[lane, f + P_PEAK] = OW[off + top - ws]
     OF[k, 0] = F[lane, f + P_PEAK]
     OF[k, 1] = b
     OF[k, 2] = F[lane, f + P_SIG]
     OF[k, 3] = d
+    OF[k, 4] = F[lane, F_DGAIN]  # the gain this window was restored with
     OI[k, O_LANE] = lane
     OI[k, O_SEQ] = I[lane, q + Q_SEQ]
     OI[k, O_START] = start
@@ -389,6 +499,7 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
     sw = PF[PF_SW]
     clip_lo = PF[PF_CLIPLO]
     clip_hi = PF[PF_CLIPHI]
+    dleak = PF[PF_DLEAK]
     hold = IP[PI_HOLD]
     maxlen = IP[PI_MAXLEN]
     warm_n = IP[PI_WARMN]
@@ -417,13 +528,23 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
             if cnt[0] > rec_cap or cnt[1] > win_cap:
                 break
             xv = x[k, lane]
-            # 2. low-pass (DF-II transposed biquads), steady state at the first sample
             y = xv
+            # 1b. discharge restoration (module docstring): x = y + (1/τ) ∫ y dt, the trapezoidal integral leaking
+            # with τ_leak, started in its steady state for the first sample
+            if dleak > 0.0:
+                if gi == 0:
+                    F[lane, F_DIS] = xv / (1.0 - dleak)
+                else:
+                    F[lane, F_DIS] = dleak * F[lane, F_DIS] + 0.5 * (xv + F[lane, F_DPREV])
+                F[lane, F_DPREV] = xv
+                y = xv + F[lane, F_DGAIN] * F[lane, F_DIS] + F[lane, F_DOFF]
+            # 2. low-pass (DF-II transposed biquads), steady state at the first sample
+            y0 = y
             if nsec > 0:
                 if gi == 0:
                     for s in range(nsec):
-                        Z[lane, s, 1] = (sos[s, 2] - sos[s, 5]) * xv
-                        Z[lane, s, 0] = (sos[s, 1] - sos[s, 4]) * xv + Z[lane, s, 1]
+                        Z[lane, s, 1] = (sos[s, 2] - sos[s, 5]) * y0
+                        Z[lane, s, 0] = (sos[s, 1] - sos[s, 4]) * y0 + Z[lane, s, 1]
                 for s in range(nsec):
                     v = sos[s, 0] * y + Z[lane, s, 0]
                     Z[lane, s, 0] = sos[s, 1] * y - sos[s, 4] * v + Z[lane, s, 1]
@@ -508,7 +629,7 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
             # emission of the queued impacts that are final
             I[lane, I_STATE] = state  # read by _emit_head (an impact in progress is the next one)
             while I[lane, I_NPEND] > 0 and gi >= I[lane, I_FIFO + I[lane, I_HEAD] * FIFO_I + Q_EMIT]:
-                _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt)
+                _emit_head(lane, gi, F, I, R, PF, IP, OF, OI, OW, cnt)
             gi += 1
             k += 1
         I[lane, I_COUNT] = gi
@@ -522,7 +643,7 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
 
 
 @nb.njit(**_JIT)
-def _flush(F, I, R, IP, OF, OI, OW, cnt):
+def _flush(F, I, R, PF, IP, OF, OI, OW, cnt):
     """End of stream: end the impact in progress (truncated) and emit everything queued."""
     lanes = F.shape[0]
     for lane in range(lanes):
@@ -531,7 +652,7 @@ def _flush(F, I, R, IP, OF, OI, OW, cnt):
             _finish(lane, I[lane, I_LAST], True, False, F, I, IP)
             I[lane, I_STATE] = S_QUIET
         while I[lane, I_NPEND] > 0:
-            _emit_head(lane, gi, F, I, R, IP, OF, OI, OW, cnt)
+            _emit_head(lane, gi, F, I, R, PF, IP, OF, OI, OW, cnt)
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -570,14 +691,22 @@ class Detector:
         self._maxwin = pre + max_len + post + 1
         omega = 2 * math.pi * (s.hum_frequency or 0.0) / rate
         decay = math.exp(-1 / (s.baseline_time_constant * rate))
+        # step 1b: a given τ fixes the gain; none given (None): the gain measured on the lane's contacts, the
+        # integral leaking with DISCHARGE_AUTO_LEAK; math.inf: a sensor that holds a static force, nothing restored
+        tau = s.discharge_time
+        leak_time = DISCHARGE_AUTO_LEAK if tau is None else DISCHARGE_LEAK * tau if math.isfinite(tau) else None
+        self._discharge_gain = 1.0 / (tau * rate) if tau is not None and math.isfinite(tau) else 0.0
         self._pf = np.array([1 - decay * decay,
                              1 - math.exp(-1 / (s.noise_time_constant * rate)),
                              s.k_on, s.k_off, s.threshold_floor, s.threshold_floor * s.k_off / s.k_on,
                              gain, math.cos(omega), math.sin(omega),
                              -math.inf if s.clip_low is None else s.clip_low,
-                             math.inf if s.clip_high is None else s.clip_high, (1 - decay) ** 2])
+                             math.inf if s.clip_high is None else s.clip_high, (1 - decay) ** 2,
+                             self._discharge_gain, 0.0 if leak_time is None else math.exp(-1.0 / (leak_time * rate)),
+                             1.0 if tau is None else 0.0, 1.0 / (MIN_DISCHARGE_TIME * rate),
+                             1.0 / (DISCHARGE_LONGEST * rate)])
         self._pi = np.array([hold, min_len, max_len, pre, post, warm_n, ring, fifo, sos.shape[0],
-                             harm.shape[0], self._maxwin], dtype=np.int64)
+                             harm.shape[0], self._maxwin, math.ceil(DISCHARGE_MARGIN * rate)], dtype=np.int64)
         self._harm, self._sos = harm, np.ascontiguousarray(sos)
         self._fifo, self._ring_len, self._warm_n = fifo, ring, warm_n
         #: Samples between an impact's end_index and its emission (max(post-trigger, offset hold)).
@@ -589,6 +718,7 @@ class Detector:
         lanes, fifo = self.lanes, self._fifo
         self._F = np.zeros((lanes, F_FIFO + fifo * FIFO_F))
         self._F[:, F_PC] = 1.0
+        self._F[:, F_DGAIN] = self._discharge_gain
         self._I = np.zeros((lanes, I_FIFO + fifo * FIFO_I), dtype=np.int64)
         self._Z = np.zeros((lanes, max(self._sos.shape[0], 1), 2))
         self._R = np.zeros((lanes, self._ring_len))
@@ -646,7 +776,7 @@ class Detector:
         if self._out_f.shape[0] < self.lanes * self._fifo or \
                 self._out_w.shape[0] < self.lanes * self._fifo * self._maxwin:
             self._grow()
-        _flush(self._F, self._I, self._R, self._pi, self._out_f, self._out_i, self._out_w, self._cnt)
+        _flush(self._F, self._I, self._R, self._pf, self._pi, self._out_f, self._out_i, self._out_w, self._cnt)
         self._flushed = True
         return self._collect()
 
@@ -671,11 +801,12 @@ class Detector:
             impacts.append(DetectedImpact(
                 lane=row[O_LANE], sequence=row[O_SEQ], start_index=row[O_START], end_index=row[O_END],
                 peak_index=row[O_PEAKI], peak_value=float(of[k, 0]), baseline=float(of[k, 1]),
-                baseline_slope=float(of[k, 3]) * self.rate, noise=float(of[k, 2]), 
+                baseline_slope=float(of[k, 3]) * self.rate, noise=float(of[k, 2]),
                 previous_end=None if row[O_PREV] < 0 else row[O_PREV],
                 next_start=None if row[O_NEXT] < 0 else row[O_NEXT],
                 clipped=bool(row[O_CLIP]), truncated=bool(row[O_TRUNC]), overlong=bool(row[O_LONG]),
-                window_start=row[O_WSTART], window=window, emitted_at=row[O_EMIT]))
+                window_start=row[O_WSTART], window=window, emitted_at=row[O_EMIT],
+                discharge_time=1.0 / (float(of[k, 4]) * self.rate) if of[k, 4] > 0.0 else None))
         self._cnt[:] = 0
         return impacts
 

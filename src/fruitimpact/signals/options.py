@@ -10,9 +10,11 @@ import math
 
 from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_flag, conflict_message
+from fruitimpact.signals.settings import MIN_DISCHARGE_TIME
 
 #: The analysis options (Python name → CLI option), with their defaults as the CLI gives them.
-ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "rebound_window": "--rebound-window", "pitch": "--pitch",
+ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "discharge_time": "--discharge-time",
+                    "rebound_window": "--rebound-window", "pitch": "--pitch",
                     "fruit_rate": "--fruit-rate", "k_on": "--k-on", "k_off": "--k-off", "clip": "--clip",
                     "fit": "--fit", "drop_height": "--drop-height", "velocity": "--velocity", "mass": "--mass",
                     "diameter": "--diameter", "poisson": "--poisson", "sort_by": "--sort-by",
@@ -45,7 +47,8 @@ def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: 
 
 #: The CLI option of each detector and analysis setting, so that their errors name what the user typed.
 _SETTING_OPTIONS = {"k_on": "--k-on", "k_off": "--k-off", "hum_frequency": "--hum", "hum_q": "--hum",
-                    "lowpass_cutoff": "--lowpass", "clip_low": "--clip", "clip_high": "--clip",
+                    "lowpass_cutoff": "--lowpass", "discharge_time": "--discharge-time", "clip_low": "--clip",
+                    "clip_high": "--clip",
                     "max_flight": "--rebound-window", "pitch": "--pitch/--fruit-rate"}
 #: The detector's windows, which no option sets: an error about one of them is about the rate.
 _WINDOWS = ("offset_hold", "min_duration", "max_duration", "pre_trigger", "post_trigger", "warmup")
@@ -61,6 +64,20 @@ def _setting_error(exc: ValueError) -> InputError:
         return _refusal("--rate", f"the sample rate is too low for the detector: its {text}")
     option = _SETTING_OPTIONS.get(name)
     return _refusal(option, text) if option else InputError(text)
+
+
+def parse_discharge(text) -> float | None:
+    """``--discharge-time``: ``auto`` (or not given: None, measured on each lane's contacts), ``none`` (math.inf: a
+    sensor that holds a static force) or a time constant [s] ≥ 10 ms."""
+    if text is None or str(text).strip().lower() == "auto":
+        return None
+    if str(text).strip().lower() == "none":
+        return math.inf
+    try:
+        return _number("--discharge-time", text, "time", low=MIN_DISCHARGE_TIME, low_inclusive=True, high=1e6)
+    except InputError:
+        raise _refusal("--discharge-time", f"must be auto, none or a time constant in [{MIN_DISCHARGE_TIME:g}, 1e+06] "
+                                           f"s (the sensor's data sheet); got {text!r}") from None
 
 
 def parse_clip(text) -> tuple:
@@ -97,6 +114,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     hum = _number("--hum", args.hum, "frequency")
     lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
     clip = parse_clip(args.clip)
+    discharge = parse_discharge(args.discharge_time)
     velocity = _number("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop
     height = _number("--drop-height", args.drop_height, "length", high=10.0)
     if velocity is not None and height is not None:
@@ -117,7 +135,8 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     poisson = _number("--poisson", args.poisson, "dimensionless", low=0.0, low_inclusive=True, high=0.4999999)
     try:
         settings = DetectorSettings(k_on=k_on, k_off=k_off, hum_frequency=hum, hum_harmonics=(1, 3) if hum else (1,),
-                                    lowpass_cutoff=lowpass, clip_low=clip[0], clip_high=clip[1])
+                                    lowpass_cutoff=lowpass, clip_low=clip[0], clip_high=clip[1],
+                                    discharge_time=discharge)
         if rate_known:
             at_rate(settings, rate)  # the checks against the rate (hum harmonics below rate/2, …), without numba
     except ValueError as exc:

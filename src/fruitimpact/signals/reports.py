@@ -21,7 +21,8 @@ FIT_KEYS = ("stiffness", "restitution", "mass", "velocity", "modulus")
 
 
 #: Keys of every report beside the indices (a contract of analyze --json and stream).
-REPORT_KEYS = ("sequence", "status", "message", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence")
+REPORT_KEYS = ("sequence", "status", "message", "rebound", "rebound_of", "rebound_ambiguous", "rebound_evidence",
+               "discharge_time")
 
 
 #: Firmness indices withheld from an overlap (they would describe neither fruit).
@@ -75,7 +76,7 @@ def report_columns(analysis: Analysis) -> tuple[str, ...]:
         columns += ["fit_residual", "fit_residual_relative", "fit_converged", "fit_message"]
     if analysis.classes is not None:
         columns += ["class", "class_by"]
-    return (*columns, "status", "message")
+    return (*columns, "status", "message", "discharge_time")
 
 
 def merge_fit(report: dict, result: dict) -> None:

@@ -27,6 +27,11 @@ MAX_LANES = 256
 __all__ = ["MAX_LANES", "Analysis", "DetectorSettings", "at_rate", "check_cutoff", "in_samples"]
 
 
+#: Shortest discharge time constant accepted [s]: a chain that discharges within 10 ms keeps little of a
+#: contact of a few ms, and restoring it would amplify the noise as much as the force.
+MIN_DISCHARGE_TIME = 0.01
+
+
 @dataclass(frozen=True)
 class DetectorSettings:
     """Settings of the impact detector (SI units; defaults suit fruit on a force plate at 10–50 kHz).
@@ -68,6 +73,12 @@ class DetectorSettings:
     clip_low, clip_high : float or None
         The acquisition's limits [N, raw sample units]: a sample at or beyond them during an impact
         flags it ``clipped``. Default None (not checked).
+    discharge_time : float or None
+        Discharge time constant τ [s] of a piezoelectric sensor chain (its data sheet's "time constant" or
+        "discharge time constant"; the charge amplifier's "short" setting is ~0.1 s), ≥ ``MIN_DISCHARGE_TIME``:
+        the detector restores the force the first-order high-pass took away (``signals.detect``, step 1b).
+        None (default): measured on each lane's own contacts and restored where it shows; ``math.inf``: a
+        sensor that holds a static force (a strain gauge), nothing measured or restored.
     """
 
     baseline_time_constant: float = 0.05
@@ -88,6 +99,7 @@ class DetectorSettings:
     lowpass_order: int = 4
     clip_low: float | None = None
     clip_high: float | None = None
+    discharge_time: float | None = None
 
     def __post_init__(self):
         def number(name, low=None, high=None, low_open=True, high_open=True, optional=False):
@@ -106,6 +118,8 @@ class DetectorSettings:
         number("lowpass_cutoff", 0, optional=True)
         number("clip_low", optional=True)
         number("clip_high", optional=True)
+        if self.discharge_time != math.inf:  # inf: a sensor that never discharges
+            number("discharge_time", MIN_DISCHARGE_TIME, low_open=False, optional=True)
         if self.clip_low is not None and self.clip_high is not None and not self.clip_low < self.clip_high:
             raise ValueError(f"clip_high must be > clip_low = {self.clip_low}; got {self.clip_high!r}")
         check_integer("lowpass_order", self.lowpass_order, 1, 8)
