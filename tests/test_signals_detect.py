@@ -422,6 +422,7 @@ def test_the_discharge_is_measured_on_the_lanes_contacts():
         at += size
     chunked += detector.flush()
     assert chunked == found
+    assert detector.discharge_time(0) == found[-1].discharge_time
     plain = detect(force + rng.standard_normal(force.size), RATE, DetectorSettings())
     assert len(plain) == 12 and all(impact.discharge_time is None for impact in plain)
 

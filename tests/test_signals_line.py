@@ -296,6 +296,13 @@ def test_a_line_whose_sensor_discharges_meets_the_issue_goals(cli, tmp_path, tol
     else:
         assert all(tau == pytest.approx(0.1, rel=0.15) for tau in measured), measured
         assert float(np.median(measured)) == pytest.approx(0.1, rel=0.03)
+        status, out, err = cli.run("analyze", path, *[o for o in options if o != "--json"])
+        assert status == 0, err
+        summary = out.splitlines()[-1]
+        head = ("sensor discharge measured on each lane's contacts and restored (no --discharge-time given): "
+                f"{truth['lanes'][0]} τ = ")
+        assert summary.startswith(head) and summary.endswith(" s"), summary
+        assert float(summary[len(head):-2]) == pytest.approx(measured[-1], rel=5e-3)
 
 
 def test_a_strain_gauge_line_restores_no_discharge(cli, tmp_path):

@@ -181,6 +181,9 @@ def cmd_analyze(args) -> int:
         speeds = analyzer.line_speeds()
         if speeds is not None:
             print(_speeds_read(speeds))
+        measured = _discharge_measured(analyzer.discharge_times())
+        if measured:
+            print(measured)
     if args.plot:
         from fruitimpact.plotting import save_figure
         from fruitimpact.plotting.signals import analysis_figure
@@ -202,6 +205,16 @@ def _speeds_read(speeds: dict) -> str:
              if speed is not None else f"{name} none (fewer than 4 clear rebounds that agree)"
              for name, speed in speeds.items()]
     return "impact speed read from each lane's rebounds (no --drop-height given): " + ", ".join(parts)
+
+
+def _discharge_measured(times: dict | None) -> str:
+    """The summary line that says each lane's sensor discharge measured on its contacts and restored (no
+    --discharge-time given), or "" when no lane showed one."""
+    if not times or all(tau is None for tau in times.values()):
+        return ""
+    parts = [f"{name} τ = {tau:.3g} s" if tau is not None else f"{name} none shown" for name, tau in times.items()]
+    return ("sensor discharge measured on each lane's contacts and restored (no --discharge-time given): "
+            + ", ".join(parts))
 
 
 def _reading_error(exc: ValueError, args) -> str:
@@ -444,8 +457,10 @@ def cmd_stream(args) -> int:
     analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, emit, source=source, on_problem=problem,
                              analysis=analysis)
     summary = _library_call(analyzer.run, iter_chunks(sys.stdin.buffer))
+    measured = _discharge_measured(analyzer.discharge_times())
     print(f"{PROG} stream: {summary['samples']} samples, {summary['impacts']} impacts"
           + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
+          + (f"; {measured}" if measured else "")
           + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
           file=sys.stderr)
     return 130 if summary["interrupted"] == "SIGINT" else 0

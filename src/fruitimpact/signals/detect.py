@@ -731,6 +731,12 @@ class Detector:
         self._cnt = np.zeros(2, dtype=np.int64)
         self._flushed = False
 
+    def discharge_time(self, lane: int) -> float | None:
+        """τ [s] of the sensor discharge the lane restores now (step 1b: given, or measured on its contacts),
+        None when it restores none."""
+        gain = float(self._F[lane, F_DGAIN])
+        return 1.0 / (gain * self.rate) if gain > 0.0 else None
+
     @property
     def samples_fed(self) -> int:
         """Samples per lane consumed since the stream's start."""

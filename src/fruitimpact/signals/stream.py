@@ -403,6 +403,13 @@ class StreamAnalyzer:
             return None
         return {name: self._analyzer.line_speed(lane) for lane, name in enumerate(self.lane_names)}
 
+    def discharge_times(self) -> dict | None:
+        """Each lane's sensor discharge τ [s] measured on its contacts and restored now (None for a lane that
+        showed none), by lane name; None when τ was given or declared none (``DetectorSettings.discharge_time``)."""
+        if self.detector.settings.discharge_time is not None:
+            return None
+        return {name: self.detector.discharge_time(lane) for lane, name in enumerate(self.lane_names)}
+
     def summary(self) -> dict:
         """Samples per lane, impacts emitted, input problems by kind, and how the stream ended."""
         source = self.source
