@@ -35,7 +35,9 @@ def _json_line(obj) -> str:
 def add_analysis_options(parser) -> None:
     """Options shared by ``analyze`` and ``stream`` (the same analysis of every impact)."""
     det = parser.add_argument_group("detection (defaults suit fruit on a force plate at 10-50 kHz)")
-    det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic")
+    det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic; "
+                                                 "auto (default): found on the first 50 ms (50 or 60 Hz, or none); "
+                                                 "none: no hum removal")
     det.add_argument("--lowpass", metavar="HZ", help="causal Butterworth low-pass (order 4) at this frequency")
     det.add_argument("--discharge-time", metavar="S",
                      help="a piezoelectric sensor chain's discharge time constant (data sheet; >= 10 ms): the force "
@@ -181,9 +183,9 @@ def cmd_analyze(args) -> int:
         speeds = analyzer.line_speeds()
         if speeds is not None:
             print(_speeds_read(speeds))
-        measured = _discharge_measured(analyzer.discharge_times())
-        if measured:
-            print(measured)
+        for line in (_hum_found(analyzer.detector), _discharge_measured(analyzer.discharge_times())):
+            if line:
+                print(line)
     if args.plot:
         from fruitimpact.plotting import save_figure
         from fruitimpact.plotting.signals import analysis_figure
@@ -205,6 +207,15 @@ def _speeds_read(speeds: dict) -> str:
              if speed is not None else f"{name} none (fewer than 4 clear rebounds that agree)"
              for name, speed in speeds.items()]
     return "impact speed read from each lane's rebounds (no --drop-height given): " + ", ".join(parts)
+
+
+def _hum_found(detector) -> str:
+    """The summary line that says which mains hum ``--hum auto`` found and removed, or "" (none found, or the
+    frequency given)."""
+    if detector.hum_found is None or detector.hum_frequency is None:
+        return ""
+    frequency, amplitude, _ = detector.hum_found
+    return f"mains hum found at {frequency:g} Hz ({amplitude:.3g} N on the first 50 ms) and removed (--hum auto)"
 
 
 def _discharge_measured(times: dict | None) -> str:
@@ -457,10 +468,11 @@ def cmd_stream(args) -> int:
     analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, emit, source=source, on_problem=problem,
                              analysis=analysis)
     summary = _library_call(analyzer.run, iter_chunks(sys.stdin.buffer))
-    measured = _discharge_measured(analyzer.discharge_times())
+    found = "; ".join(line for line in (_hum_found(analyzer.detector), _discharge_measured(analyzer.discharge_times()))
+                      if line)
     print(f"{PROG} stream: {summary['samples']} samples, {summary['impacts']} impacts"
           + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
-          + (f"; {measured}" if measured else "")
+          + (f"; {found}" if found else "")
           + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
           file=sys.stderr)
     return 130 if summary["interrupted"] == "SIGINT" else 0

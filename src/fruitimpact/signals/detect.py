@@ -87,9 +87,9 @@ import numpy as np
 from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.impact.validation import check_integer
 from fruitimpact.signals.filters import butterworth_sos, solve_small
-from fruitimpact.signals.settings import MIN_DISCHARGE_TIME, DetectorSettings, at_rate, check_rate
+from fruitimpact.signals.settings import HUM_AUTO, MIN_DISCHARGE_TIME, DetectorSettings, at_rate, check_rate
 
-__all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect"]
+__all__ = ["DetectedImpact", "Detector", "DetectorSettings", "butterworth_sos", "detect", "find_mains_hum"]
 
 # ---------------------------------------------------------------------------------------------------------
 # Settings
@@ -246,6 +246,10 @@ PI_HOLD, PI_MINLEN, PI_MAXLEN, PI_PRE, PI_POST, PI_WARMN, PI_L, PI_FIFO, PI_NSEC
     PI_DMARGIN = range(12)
 N_PI = 12
 
+#: The mains frequencies [Hz] ``find_mains_hum`` looks for.
+MAINS_FREQUENCIES = (50.0, 60.0)
+#: A mains hum is found when its fundamental's amplitude exceeds this many of its standard errors.
+HUM_SHOWN = 5.0
 #: E[min(|Z|, 3)] for a standard normal Z: the clipped mean absolute deviation of unit noise.
 CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / math.sqrt(2))
 #: 1/Φ⁻¹(3/4): σ of normal noise from its median absolute deviation.
@@ -683,13 +687,11 @@ class Detector:
         windows = at_rate(s, rate)  # every check against the rate (settings.at_rate)
         hold, min_len, max_len = windows["offset_hold"], windows["min_duration"], windows["max_duration"]
         pre, post, warm_n, gain = windows["pre_trigger"], windows["post_trigger"], windows["warmup"], windows["hum_gain"]
-        harm = np.array(s.hum_harmonics if s.hum_frequency is not None else (), dtype=np.int64)
         sos = (butterworth_sos(s.lowpass_cutoff, s.lowpass_order, rate) if s.lowpass_cutoff is not None
                else np.zeros((0, 6)))
         fifo = post // (min_len + hold) + 4
         ring = pre + max_len + post + hold + 2
         self._maxwin = pre + max_len + post + 1
-        omega = 2 * math.pi * (s.hum_frequency or 0.0) / rate
         decay = math.exp(-1 / (s.baseline_time_constant * rate))
         # step 1b: a given τ fixes the gain; none given (None): the gain measured on the lane's contacts, the
         # integral leaking with DISCHARGE_AUTO_LEAK; math.inf: a sensor that holds a static force, nothing restored
@@ -699,23 +701,46 @@ class Detector:
         self._pf = np.array([1 - decay * decay,
                              1 - math.exp(-1 / (s.noise_time_constant * rate)),
                              s.k_on, s.k_off, s.threshold_floor, s.threshold_floor * s.k_off / s.k_on,
-                             gain, math.cos(omega), math.sin(omega),
+                             0.0, 1.0, 0.0,  # the hum's gain and phasor step: _set_hum
                              -math.inf if s.clip_low is None else s.clip_low,
                              math.inf if s.clip_high is None else s.clip_high, (1 - decay) ** 2,
                              self._discharge_gain, 0.0 if leak_time is None else math.exp(-1.0 / (leak_time * rate)),
                              1.0 if tau is None else 0.0, 1.0 / (MIN_DISCHARGE_TIME * rate),
                              1.0 / (DISCHARGE_LONGEST * rate)])
         self._pi = np.array([hold, min_len, max_len, pre, post, warm_n, ring, fifo, sos.shape[0],
-                             harm.shape[0], self._maxwin, math.ceil(DISCHARGE_MARGIN * rate)], dtype=np.int64)
-        self._harm, self._sos = harm, np.ascontiguousarray(sos)
+                             0, self._maxwin, math.ceil(DISCHARGE_MARGIN * rate)], dtype=np.int64)
+        self._sos = np.ascontiguousarray(sos)
+        self._hum_auto = s.hum_frequency == HUM_AUTO
+        self.hum_found: tuple | None = None
+        self._set_hum(None if self._hum_auto else s.hum_frequency, gain)
         self._fifo, self._ring_len, self._warm_n = fifo, ring, warm_n
         #: Samples between an impact's end_index and its emission (max(post-trigger, offset hold)).
         self.latency_samples = max(post, hold)
         self.reset()
 
+    def _set_hum(self, frequency: float | None, gain: float | None = None) -> None:
+        """Remove the hum at ``frequency`` [Hz] with the settings' harmonics (those below rate/2), or none."""
+        s = self.settings
+        harmonics = () if frequency is None else tuple(k for k in s.hum_harmonics if k * frequency < self.rate / 2)
+        if gain is None and frequency is not None:
+            gain = 2 * math.pi * frequency / (s.hum_q * self.rate)
+        if not harmonics or not gain < 0.5:  # auto at a rate too low for a notch there: none
+            frequency, harmonics, gain = None, (), 0.0
+        omega = 2 * math.pi * (frequency or 0.0) / self.rate
+        self._harm = np.array(harmonics, dtype=np.int64)
+        self._pf[PF_G], self._pf[PF_CW], self._pf[PF_SW] = gain, math.cos(omega), math.sin(omega)
+        self._pi[PI_NH] = len(harmonics)
+        #: The mains frequency [Hz] whose hum is removed (given, or found: ``find_mains_hum``), None when none.
+        self.hum_frequency = frequency
+
     def reset(self) -> None:
         """Forget everything: the next sample fed is sample 0 of a new stream."""
         lanes, fifo = self.lanes, self._fifo
+        if self._hum_auto:  # the hum is found again on the new stream's first samples
+            self._set_hum(None)
+            self._held: list[np.ndarray] | None = []
+            #: (frequency [Hz] or None, largest fundamental amplitude [N], its standard error [N]) found
+            self.hum_found = None
         self._F = np.zeros((lanes, F_FIFO + fifo * FIFO_F))
         self._F[:, F_PC] = 1.0
         self._F[:, F_DGAIN] = self._discharge_gain
@@ -739,8 +764,27 @@ class Detector:
 
     @property
     def samples_fed(self) -> int:
-        """Samples per lane consumed since the stream's start."""
-        return int(self._I[0, I_COUNT])
+        """Samples per lane consumed since the stream's start (those held to find the hum included)."""
+        return int(self._I[0, I_COUNT]) + self._held_count()
+
+    def _held_count(self) -> int:
+        return sum(x.shape[0] for x in self._held) if self._hum_auto and self._held is not None else 0
+
+    def _release(self, x: np.ndarray | None, final: bool = False) -> np.ndarray | None:
+        """With the hum found automatically: hold the samples until the first ``warmup`` are in, then find the
+        hum on them (``find_mains_hum``) and return everything held; at the stream's end (``final``) decide on what
+        there is.  Without: ``x`` itself."""
+        if not self._hum_auto or self._held is None:
+            return x
+        if x is not None and x.shape[0]:
+            self._held.append(x)
+        if self._held_count() < self._warm_n and not final:
+            return None
+        held = np.concatenate(self._held) if self._held else np.zeros((0, self.lanes))
+        self._held = None
+        self.hum_found = find_mains_hum(held[:self._warm_n], self.rate, self.settings.hum_harmonics)
+        self._set_hum(self.hum_found[0])
+        return held
 
     def _as_samples(self, samples) -> np.ndarray:
         x = np.asarray(samples)
@@ -761,9 +805,10 @@ class Detector:
         became final, sorted by (emitted_at, lane)."""
         if self._flushed:
             raise RuntimeError("this Detector was flushed (its stream ended); call reset() to start a new stream")
-        x = self._as_samples(samples)
-        if x.shape[0] == 0:
-            return []
+        x = self._release(self._as_samples(samples))
+        return self._process(x) if x is not None and x.shape[0] else []
+
+    def _process(self, x: np.ndarray) -> list[DetectedImpact]:
         pos = np.zeros(self.lanes, dtype=np.int64)
         self._cnt[:] = 0
         while True:
@@ -778,13 +823,17 @@ class Detector:
         """End the stream: emit the impact in progress (``truncated``) and every impact still held."""
         if self._flushed:
             return []
+        early = []
+        held = self._release(None, final=True)
+        if held is not None and held.shape[0]:
+            early = self._process(held)
         self._cnt[:] = 0
         if self._out_f.shape[0] < self.lanes * self._fifo or \
                 self._out_w.shape[0] < self.lanes * self._fifo * self._maxwin:
             self._grow()
         _flush(self._F, self._I, self._R, self._pf, self._pi, self._out_f, self._out_i, self._out_w, self._cnt)
         self._flushed = True
-        return self._collect()
+        return early + self._collect()
 
     def _grow(self) -> None:
         n_rec, n_win = self._cnt
@@ -815,6 +864,47 @@ class Detector:
                 discharge_time=1.0 / (float(of[k, 4]) * self.rate) if of[k, 4] > 0.0 else None))
         self._cnt[:] = 0
         return impacts
+
+
+def find_mains_hum(samples: np.ndarray, rate: float, harmonics=(1, 3)) -> tuple[float | None, float, float]:
+    """The mains hum in the quiet samples [N] (samples × lanes) at ``rate`` [Hz]: (50.0, 60.0 or None, the largest
+    fundamental amplitude [N] over the lanes, its standard error [N]).
+
+    Each lane is fitted by least squares with a level, a slope and, for both 50 and 60 Hz, the cosine and sine of
+    each of ``harmonics`` below rate/2 (over the 50 ms warm-up, the two fundamentals are half a cycle apart and
+    separable: correlation 0.64).  A frequency is found when its fundamental's amplitude exceeds ``HUM_SHOWN``
+    standard errors σ √(2/n) (σ the fit's residual sd, n samples) and that of the other frequency; hum below that
+    (≤ 0.2 σ at 20 kHz) moves no result.  Fewer than 16 samples: none."""
+    x = np.asarray(samples, dtype=float)
+    if x.ndim == 1:
+        x = x[:, None]
+    n = x.shape[0]
+    if n < 16:
+        return None, 0.0, math.inf
+    t = np.arange(n) / rate
+    columns = [np.ones(n), t - t.mean()]
+    fundamentals = {}
+    for frequency in MAINS_FREQUENCIES:
+        for k in harmonics:
+            if k * frequency < rate / 2:
+                if k == harmonics[0]:
+                    fundamentals[frequency] = len(columns)
+                columns += [np.cos(2 * math.pi * k * frequency * t), np.sin(2 * math.pi * k * frequency * t)]
+    if not fundamentals:
+        return None, 0.0, math.inf
+    design = np.column_stack(columns)
+    coefficients, *_ = np.linalg.lstsq(design, x, rcond=None)
+    residual = x - design @ coefficients
+    sigma = np.sqrt(np.sum(residual ** 2, axis=0) / max(n - design.shape[1], 1))
+    error = sigma * math.sqrt(2.0 / n)
+    amplitude = {f: np.hypot(coefficients[j], coefficients[j + 1]) for f, j in fundamentals.items()}
+    best = max(amplitude, key=lambda f: float(np.max(amplitude[f] / np.maximum(error, 1e-300))))
+    lane = int(np.argmax(amplitude[best] / np.maximum(error, 1e-300)))
+    found, size, spread = best, float(amplitude[best][lane]), float(error[lane])
+    others = [float(amplitude[f][lane]) for f in amplitude if f != best]
+    if not (size > HUM_SHOWN * spread and all(size > other for other in others)):
+        return None, size, spread
+    return found, size, spread
 
 
 def detect(force, rate: float, settings: DetectorSettings | None = None) -> list[DetectedImpact]:

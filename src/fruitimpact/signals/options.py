@@ -10,7 +10,7 @@ import math
 
 from fruitimpact.impact.units import parse_quantity
 from fruitimpact.impact.validation import InputError, check_flag, conflict_message
-from fruitimpact.signals.settings import MIN_DISCHARGE_TIME
+from fruitimpact.signals.settings import HUM_AUTO, MIN_DISCHARGE_TIME
 
 #: The analysis options (Python name → CLI option), with their defaults as the CLI gives them.
 ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "discharge_time": "--discharge-time",
@@ -19,7 +19,7 @@ ANALYSIS_OPTIONS = {"hum": "--hum", "lowpass": "--lowpass", "discharge_time": "-
                     "fit": "--fit", "drop_height": "--drop-height", "velocity": "--velocity", "mass": "--mass",
                     "diameter": "--diameter", "poisson": "--poisson", "sort_by": "--sort-by",
                     "thresholds": "--thresholds", "classes": "--classes"}
-ANALYSIS_DEFAULTS = {"k_on": "6", "k_off": "3", "fit": False}
+ANALYSIS_DEFAULTS = {"hum": "auto", "k_on": "6", "k_off": "3", "fit": False}
 
 
 _NAMES = {option: name for name, option in ANALYSIS_OPTIONS.items()}
@@ -64,6 +64,20 @@ def _setting_error(exc: ValueError) -> InputError:
         return _refusal("--rate", f"the sample rate is too low for the detector: its {text}")
     option = _SETTING_OPTIONS.get(name)
     return _refusal(option, text) if option else InputError(text)
+
+
+def parse_hum(text) -> float | str | None:
+    """``--hum``: ``auto`` (the default: 50 or 60 Hz found on the stream's first samples, or none), ``none`` (None)
+    or the mains frequency [Hz]."""
+    word = str(text).strip().lower() if text is not None else "auto"
+    if word == HUM_AUTO:
+        return HUM_AUTO
+    if word == "none":
+        return None
+    try:
+        return _number("--hum", text, "frequency")
+    except InputError:
+        raise _refusal("--hum", f"must be auto, none or the mains frequency in Hz (50 or 60); got {text!r}") from None
 
 
 def parse_discharge(text) -> float | None:
@@ -111,7 +125,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
     from fruitimpact.signals.settings import DetectorSettings, at_rate
 
     # every plain check first: a usage error is answered before the detector and the fit (numba) are imported
-    hum = _number("--hum", args.hum, "frequency")
+    hum = parse_hum(args.hum)
     lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
     clip = parse_clip(args.clip)
     discharge = parse_discharge(args.discharge_time)

@@ -24,9 +24,12 @@ if TYPE_CHECKING:
 #: Most lanes (force channels) of one recording or stream: analyze, stream and the web app's pages.
 MAX_LANES = 256
 
-__all__ = ["MAX_LANES", "Analysis", "DetectorSettings", "at_rate", "check_cutoff", "in_samples"]
+__all__ = ["HUM_AUTO", "MAX_LANES", "MIN_DISCHARGE_TIME", "Analysis", "DetectorSettings", "at_rate", "check_cutoff",
+           "in_samples"]
 
 
+#: ``DetectorSettings.hum_frequency`` that finds the mains frequency on the stream's first samples.
+HUM_AUTO = "auto"
 #: Shortest discharge time constant accepted [s]: a chain that discharges within 10 ms keeps little of a
 #: contact of a few ms, and restoring it would amplify the noise as much as the force.
 MIN_DISCHARGE_TIME = 0.01
@@ -59,8 +62,10 @@ class DetectorSettings:
         Longest contact [s]: longer ones are ended (``overlong``) and the baseline is re-learnt. Default 0.1.
     pre_trigger, post_trigger : float
         Margins [s] kept in the window before the onset and after the end. Default 2e-3 each.
-    hum_frequency : float or None
-        Mains frequency [Hz] (50 or 60) of the hum to remove; None (default): no hum removal.
+    hum_frequency : float, "auto" or None
+        Mains frequency [Hz] (50 or 60) of the hum to remove; ``"auto"``: found on the first ``warmup`` of the
+        stream (50 or 60 Hz, where its amplitude is shown: ``signals.detect.find_mains_hum``), none when no lane
+        shows one; None (default): no hum removal.
     hum_q : float
         Q of the hum notch (−3 dB bandwidth ≈ hum_frequency/Q; the canceller settles in ≈ Q/(π f) s).
         Default 10.
@@ -113,7 +118,8 @@ class DetectorSettings:
         for name in ("threshold_floor", "pre_trigger", "post_trigger"):
             number(name, 0, low_open=False)
         number("max_duration", self.min_duration, 60.0, high_open=False)
-        number("hum_frequency", 0, optional=True)
+        if self.hum_frequency != HUM_AUTO:
+            number("hum_frequency", 0, optional=True)
         number("hum_q", 0.5)
         number("lowpass_cutoff", 0, optional=True)
         number("clip_low", optional=True)
@@ -181,7 +187,7 @@ def at_rate(settings: DetectorSettings, rate: float) -> dict:
     out.update(pre_trigger=in_samples("pre_trigger", s.pre_trigger, rate, 0),
                post_trigger=in_samples("post_trigger", s.post_trigger, rate, 0),
                warmup=in_samples("warmup", s.warmup, rate, 16), hum_gain=0.0)
-    if s.hum_frequency is not None:
+    if s.hum_frequency is not None and s.hum_frequency != HUM_AUTO:
         top = s.hum_frequency * s.hum_harmonics[-1]
         if not top < rate / 2:
             raise ValueError(f"hum_frequency × the highest harmonic must be below rate/2 = {rate / 2:g} Hz; "
