@@ -91,6 +91,8 @@ def test_an_uploaded_recording_is_analysed_as_analyze_does(server, line_recordin
     assert sum(body["histogram"]["counts"]) == body["histogram"]["fruit"] == len(indexed)
     assert body["classes"] == fruit["class"].dropna().value_counts().to_dict()
     assert body["histogram"]["thresholds"] == [1e7, 2e7]
+    # what the detector found of the sensor: the hum given (50 Hz) removed; no τ given, none shown on this line
+    assert body["hum"] == 50.0 and body["discharge"] == {lane: None for lane in body["lanes"]}
     # the overview keeps every peak: its greatest force is the recording's
     samples = np.fromfile(path, dtype="<f4").reshape(-1, 4)
     for k, lane in enumerate(body["lanes"]):

@@ -196,7 +196,7 @@ def analyze(request, uploads) -> dict:
         "analysis": key, "file": upload.name, "size": upload.size, "format": source.format,
         "rate": run.rate, "lanes": run.lane_names, "samples": run.samples, "duration": run.samples / run.rate,
         "start_time": run.start_time, "columns": run.columns, "impacts": rows, "contacts": len(rows),
-        "fruit": fruit, "rebounds": len(rows) - fruit,
+        "fruit": fruit, "rebounds": len(rows) - fruit, "hum": run.hum, "discharge": run.discharge,
         "by_lane": {name: sum(1 for row in rows if row["lane"] == name) for name in run.lane_names},
         "histogram": _histogram(rows, index, thresholds), "classes": classes,
         "class_names": list(run.classes.labels) if run.classes is not None else [],

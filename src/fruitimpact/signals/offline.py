@@ -77,7 +77,8 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
 @dataclass
 class AnalysisRun:
     """What :func:`run_analysis` found: the rows of ``analyze``'s table, its columns, the recording's lanes,
-    rate [Hz], first sample's time [s] and samples per lane fed, and the firmness classes used (or None)."""
+    rate [Hz], first sample's time [s] and samples per lane fed, the firmness classes used (or None), and what the
+    detector found of the sensor: the hum removed and each lane's discharge restored."""
 
     rows: list
     columns: list
@@ -87,6 +88,11 @@ class AnalysisRun:
     samples: int
     classes: object = None
     notes: tuple = ()  # what the file's reader found odd but could read (RecordingSource.notes)
+    #: the mains frequency [Hz] whose hum was removed (given, or found: ``--hum auto``), None when none
+    hum: float | None = None
+    #: each lane's sensor discharge τ [s] measured and restored at the end (``StreamAnalyzer.discharge_times``;
+    #: None when τ was given or declared none)
+    discharge: dict | None = None
 
 
 def run_analysis(source, *, rate=None, column: str | None = None, format: str | None = None, lanes: int = 1,
@@ -158,7 +164,8 @@ def run_analysis(source, *, rate=None, column: str | None = None, format: str | 
     # the same columns in the same order whatever the contacts (a quiet recording, a fit that never converged)
     columns = list(report_columns(analysis))
     columns += [key for key in dict.fromkeys(k for row in rows for k in row) if key not in columns]
-    return AnalysisRun(rows, columns, names, rate_value, start, samples_fed, analysis.classes, notes)
+    return AnalysisRun(rows, columns, names, rate_value, start, samples_fed, analysis.classes, notes,
+                       analyzer.detector.hum_frequency, analyzer.discharge_times())
 
 
 def _watched(chunks, on_chunk):

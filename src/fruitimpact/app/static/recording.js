@@ -85,12 +85,21 @@ function firstFruit(answer) {
   return k >= 0 ? k : 0;
 }
 
+// The sensor discharge each lane measured and restored (--discharge-time auto), when any did.
+function discharge(a, item) {
+  const measured = Object.entries(a.discharge || {}).filter(([, tau]) => tau !== null);
+  if (!measured.length) return "";
+  const text = measured.map(([lane, tau]) => (a.lanes.length > 1 ? `${escapeText(lane)} ` : "") + `${fmt(tau, 3)} s`);
+  return item("sensor discharge τ (measured)", text.join(", "));
+}
+
 function draw(a) {
   const summary = document.getElementById("summary");
   const item = (label, value) => `<div class="item"><span>${label}</span><b>${value}</b></div>`;
   summary.innerHTML = item("file", escapeText(a.file)) + item("lanes", a.lanes.length) +
     item("duration", `${fmt(a.duration, 4)} s at ${fmt(a.rate / 1000, 4)} kHz`) +
-    item("fruit", `<span class="big">${a.fruit}</span>`) + item("rebounds", a.rebounds) + item("contacts", a.contacts);
+    item("fruit", `<span class="big">${a.fruit}</span>`) + item("rebounds", a.rebounds) + item("contacts", a.contacts) +
+    item("mains hum removed", a.hum ? `${fmt(a.hum, 3)} Hz` : "none") + discharge(a, item);
   drawOverview(a);
   drawHistogram(a);
   drawTable(a);
