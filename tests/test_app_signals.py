@@ -325,6 +325,14 @@ def test_the_recording_page_in_a_real_browser(server, line_recording):
         expected = fi.analyze(path, rate=RATE, lanes=4, fit=True, drop_height="5cm")
         assert page.evaluate("window.fruitimpact.last.contacts") == len(expected)
         assert page.locator("#impacts tbody tr").count() == len(expected)
+        # every row's status is in sight without scrolling the table sideways, also where the table is wider than
+        # its panel (it had been the last column, past the panel's edge: "ok, ambiguous" cut at 1300 px)
+        page.set_viewport_size({"width": 1000, "height": 1000})
+        frame = page.locator(".table-scroll").first.bounding_box()
+        assert page.evaluate("document.querySelector('.table-scroll').scrollWidth") > frame["width"]
+        status = page.locator("#impacts thead th", has_text="status").bounding_box()
+        assert status["x"] + status["width"] <= frame["x"] + frame["width"]
+        page.set_viewport_size({"width": 1400, "height": 1000})
         # a click on an impact: its curve with the fitted model over it
         # the click's request races a re-analysis the page may still start from its inputs' change events (then
         # the answer belongs to a replaced analysis and is dropped): click again until the impact is shown

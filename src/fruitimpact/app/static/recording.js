@@ -16,10 +16,11 @@ window.fruitimpact = {analyses: 0, last: null, impact: null};
 
 // The table's columns: key, heading, scale to the unit shown.
 const COLUMNS = [
-  ["#", "#", null], ["lane", "lane", null], ["start_time", "start [s]", 1], ["peak_force", "F_max [N]", 1],
-  ["time_to_peak", "t_c [ms]", 1e3], ["contact_duration", "T [ms]", 1e3], ["firmness_c", "C [N/s]", 1],
-  ["firmness_c_star", "C* [N/s²]", 1], ["stiffness", "k [N/m^1.5]", 1], ["restitution", "e", 1],
-  ["mass", "m [g]", 1e3], ["class", "class", null], ["rebound_of", "rebound of", null], ["status", "status", null],
+  // the status beside the contact's number: a flag must be seen without scrolling the table sideways
+  ["#", "#", null], ["lane", "lane", null], ["status", "status", null], ["start_time", "start [s]", 1],
+  ["peak_force", "F_max [N]", 1], ["time_to_peak", "t_c [ms]", 1e3], ["contact_duration", "T [ms]", 1e3],
+  ["firmness_c", "C [N/s]", 1], ["firmness_c_star", "C* [N/s²]", 1], ["stiffness", "k [N/m^1.5]", 1],
+  ["restitution", "e", 1], ["mass", "m [g]", 1e3], ["class", "class", null], ["rebound_of", "rebound of", null],
 ];
 
 function inputs() {
