@@ -369,38 +369,55 @@ def test_hum_removal_needed_and_sufficient():
 
 @pytest.mark.parametrize("frequency", [50.0, 60.0, None])
 def test_the_mains_hum_is_found_on_the_first_samples(frequency):
-    """``find_mains_hum`` on 50 ms of quiet signal at 20 kHz (σ = 1 N noise, a level and a slope, a 3rd harmonic at
-    30 %): hum of 0.5 N (0.5 σ, half the impact-sensor note's "≲ 1 % of F_max" for a 100 N fruit) at 50 or 60 Hz
-    ±0.2 % is found at its frequency, its amplitude within 4 standard errors σ √(2/n) (the least-squares fit's
-    own); without hum nothing is found at any of 40 seeds (the threshold is 5 standard errors: ~1e-5 per lane)."""
-    n = 1000
+    """``find_mains_hum`` on the first 0.2 s at 20 kHz (σ = 1 N noise, a level and a slope, a 3rd harmonic at
+    30 %, a 100 N contact inside the window, a 20 Hz vibration of 1 σ): hum of 0.5 N (0.5 σ, half the impact-sensor
+    note's "≲ 1 % of F_max" for a 100 N fruit) at 50 or 60 Hz ±0.2 % is found at its frequency, its amplitude
+    within 4 standard errors; the standard error is the least-squares fit's own, ≈ σ √(2/n) over 10 cycles where
+    the columns are near orthogonal (σ with the vibration's variance, n without the contact's samples).  Without
+    hum nothing is
+    found: at 40 seeds on one lane, at 10 seeds on 16 lanes (the false-alarm chance is 1e-6 over all lanes), nor on
+    a constant lane beside a noisy one (its residual is rounding: no hum below 1 mN counts)."""
+    n = 4000
     t = np.arange(n) / RATE
+    imp = hunt_crossley(0.2, 3.5e6, 1.0, 0.55)
     for seed in range(40 if frequency is None else 10):
         rng = np.random.default_rng(seed)
-        x = 3.0 + 20.0 * t + rng.standard_normal(n)
+        x = 3.0 + 20.0 * t + rng.standard_normal(n) + np.sin(2 * np.pi * 20.0 * t + rng.uniform(0, 6))
+        idx, values = sensor_samples(imp, rng.uniform(0.05, 0.15), n, plate=False)
+        x[idx] += values
         if frequency is not None:
             f = frequency * (1 + rng.uniform(-0.002, 0.002))
             x += 0.5 * np.sin(2 * np.pi * f * t + rng.uniform(0, 6)) + 0.15 * np.sin(6 * np.pi * f * t + 1.0)
         found, amplitude, error = find_mains_hum(x, RATE)
         assert found == frequency, (seed, amplitude, error)
-        assert error == pytest.approx(math.sqrt(2 / n), rel=0.1)
         if frequency is not None:
+            # σ √(2/n) at best; the vibration, unmodelled, adds half a variance and the contact's 40 ms are left out
+            assert math.sqrt(2 / n) < error < math.sqrt(1.5) * math.sqrt(2 / (0.75 * n))
             assert abs(amplitude - 0.5) < 4 * error
+    if frequency is None:
+        for seed in range(10):
+            noise = np.random.default_rng(100 + seed).standard_normal((n, 16))
+            assert find_mains_hum(noise, RATE)[0] is None
+        lanes = np.column_stack([np.full(n, 7.3), np.random.default_rng(1).standard_normal(n)])
+        assert find_mains_hum(lanes, RATE)[0] is None
 
 
 def test_a_hum_found_removes_what_a_hum_given_does(recording, detected):
     """``hum_frequency="auto"`` on the two 50 s lanes (hum at 50.1 Hz, 0.5 % of the median peak): 50 Hz is found on
-    the first 50 ms, and the impacts are those of the detector told 50 Hz, every field, fed whole or in random
-    chunks (the samples are held until the first 50 ms are in)."""
+    the first 0.2 s, and the impacts are those of the detector told 50 Hz, every field, fed in random chunks (the
+    samples are held until the first 0.2 s are in, copied: the caller may reuse its buffer)."""
     x, _, _ = recording
     auto = dataclasses.replace(SETTINGS, hum_frequency="auto")
     rng = np.random.default_rng(11)
     detector = Detector(RATE, auto, lanes=2)
     streamed, position = [], 0
+    buffer = np.empty((50_000, 2))
     while position < x.shape[0]:
-        size = int(np.exp(rng.uniform(0, math.log(50_000))))
-        streamed += detector.feed(x[position:position + size])
-        assert detector.samples_fed == min(position + size, x.shape[0])
+        size = min(int(np.exp(rng.uniform(0, math.log(50_000)))), x.shape[0] - position)
+        buffer[:size] = x[position:position + size]
+        streamed += detector.feed(buffer[:size])
+        buffer[:size] = 0.0  # a reader reusing its buffer
+        assert detector.samples_fed == position + size
         position += size
     streamed += detector.flush()
     assert detector.hum_frequency == 50.0 and detector.hum_found[0] == 50.0
@@ -467,6 +484,11 @@ def test_the_discharge_is_measured_on_the_lanes_contacts():
     assert detector.discharge_time(0) == found[-1].discharge_time
     plain = detect(force + rng.standard_normal(force.size), RATE, DetectorSettings())
     assert len(plain) == 12 and all(impact.discharge_time is None for impact in plain)
+    # a measurement faster than MIN_DISCHARGE_TIME is no sensor's and is dropped, not restored at that limit (a
+    # review found one misread contact, measured at 0.8 ms and capped at 10 ms, had made every later contact
+    # overlong): a 2 ms chain is left as it is
+    _, fast, _, _ = _discharged(0.002, 6, noise=1.0)
+    assert all(impact.discharge_time is None for impact in detect(fast, RATE, DetectorSettings()))
 
 
 def test_lowpass_matches_scipy():

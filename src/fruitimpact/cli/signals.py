@@ -35,11 +35,11 @@ def _json_line(obj) -> str:
 def add_analysis_options(parser) -> None:
     """Options shared by ``analyze`` and ``stream`` (the same analysis of every impact)."""
     det = parser.add_argument_group("detection (defaults suit fruit on a force plate at 10-50 kHz)")
-    det.add_argument("--hum", metavar="HZ", help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic; "
-                                                 "auto (default): found on the first 50 ms (50 or 60 Hz, or none); "
-                                                 "none: no hum removal")
+    det.add_argument("--hum", metavar="HZ|auto|none",
+                     help="remove mains hum at this frequency (50 or 60) and its 3rd harmonic; auto (default): "
+                          "found on the first 0.2 s (50 or 60 Hz, or none); none: no hum removal")
     det.add_argument("--lowpass", metavar="HZ", help="causal Butterworth low-pass (order 4) at this frequency")
-    det.add_argument("--discharge-time", metavar="S",
+    det.add_argument("--discharge-time", metavar="S|auto|none",
                      help="a piezoelectric sensor chain's discharge time constant (data sheet; >= 10 ms): the force "
                           "its high-pass took away is restored; auto (default): measured on each lane's contacts and "
                           "restored where it shows; none: the sensor holds a static force (strain gauge)")
@@ -215,7 +215,7 @@ def _hum_found(detector) -> str:
     if detector.hum_found is None or detector.hum_frequency is None:
         return ""
     frequency, amplitude, _ = detector.hum_found
-    return f"mains hum found at {frequency:g} Hz ({amplitude:.3g} N on the first 50 ms) and removed (--hum auto)"
+    return f"mains hum found at {frequency:g} Hz ({amplitude:.3g} N on the first 0.2 s) and removed (--hum auto)"
 
 
 def _discharge_measured(times: dict | None) -> str:

@@ -10,16 +10,27 @@ flushed.
 
 Per sample and lane, in this order:
 
+0. **Mains hum found** (``hum_frequency="auto"``): the first ``HUM_WINDOW`` of samples are held and
+   ``find_mains_hum`` decides 50, 60 Hz or none before anything else; then they are processed as any others.
 1. **Clipping**: the raw sample at or beyond ``clip_low``/``clip_high`` marks the impact in progress
    ``clipped``.
-1b. **Discharge restoration** (optional, ``discharge_time`` τ given): a piezoelectric chain (quartz sensor and
-   charge amplifier, or IEPE) is a first-order high-pass, dy/dt = dx/dt − y/τ, so a contact of impulse I droops
-   by up to I/τ and the signal undershoots by ≈ I/τ after it (a few % of the peak at τ = 0.1 s: the fitted
-   stiffness was ~10 % off in the scorecard's lines).  Its inverse is x = y + (1/τ) ∫ y dt; the integral is the
-   trapezoidal sum of the raw samples, leaking with ``DISCHARGE_LEAK`` · τ so that the acquisition's own offset
-   stays bounded (the chain and its inverse together are then a high-pass of time constant ``DISCHARGE_LEAK`` ·
-   τ, whose droop over a contact is a hundredth of the sensor's; the offset comes out ``DISCHARGE_LEAK`` + 1
-   times larger and is the baseline the next stage removes), started in its steady state for the first sample.
+1b. **Discharge restoration** (``discharge_time``: τ given, measured, or ``math.inf``: none): a piezoelectric
+   chain (quartz sensor and charge amplifier, or IEPE) is a first-order high-pass, dy/dt = dx/dt − y/τ, so a
+   contact of impulse I droops by up to I/τ and the signal undershoots by ≈ I/τ after it (a few % of the peak at
+   τ = 0.1 s: the fitted stiffness was ~10 % off in the scorecard's lines). Its inverse is x = y + (1/τ) ∫ y dt;
+   the integral is the trapezoidal sum of the raw samples, leaking with ``DISCHARGE_LEAK`` · τ so that the
+   acquisition's own offset stays bounded (the chain and its inverse together are then a high-pass of time
+   constant ``DISCHARGE_LEAK`` · τ, whose droop over a contact is a hundredth of the sensor's; the offset comes
+   out ``DISCHARGE_LEAK`` + 1 times larger and is the baseline the next stage removes), started in its steady
+   state for the first sample. Measured (τ None): at each lone contact's emission (``_measure_discharge``) the
+   window's samples after the contact, against the level before its foot, sit at −κ times the window's running
+   integral, κ = 1/τ still missing; each measurement's standard error counts the noise's lag-1 correlation (a
+   low-passed noise), one faster than ``MIN_DISCHARGE_TIME`` is dropped. The lane restores the median of its last
+   ``DISCHARGE_KEPT`` once it exceeds ``DISCHARGE_SHOWN`` standard errors (from ``DISCHARGE_SCATTER_FROM``
+   measurements on, also their own scatter's), keeps it above ``DISCHARGE_HELD``, restores the window that showed
+   it, keeps the signal continuous where the gain changes (an offset), and drops it at an overlong contact. The
+   integral leaks with ``DISCHARGE_AUTO_LEAK``. Contacts at rates where fewer than 3 samples follow the contact
+   in its window, or so long (≥ ~12 ms at 20 kHz) that none precede its foot in the window, measure nothing.
 2. **Low-pass** (optional): a causal Butterworth of ``lowpass_order`` at ``lowpass_cutoff``, a cascade
    of biquads designed here (bilinear transform with prewarping; no SciPy at run time), started in
    its steady state for the first sample.
@@ -189,8 +200,8 @@ class DetectedImpact:
 
 #: The discharge restoration's leak, in units of the sensor's time constant τ (step 1b of the module docstring).
 DISCHARGE_LEAK = 100.0
-#: The leak [s] of the integral when the discharge is measured (τ not given): 100 times the longest τ a line's
-#: contacts show (~1 s: beyond it the undershoot of one contact is within its noise).
+#: The leak [s] of the integral when the discharge is measured (τ not given): 100 times the τ of ~1 s beyond which
+#: one contact's undershoot is within its noise, ten times the longest restored (``DISCHARGE_LONGEST``).
 DISCHARGE_AUTO_LEAK = 100.0
 #: The longest τ [s] restored when measured: a slower discharge droops a contact by < 1e-3 of its impulse (and
 #: on a noise-free signal any residual would otherwise count as shown).
@@ -203,9 +214,11 @@ DISCHARGE_SHOWN = 5.0
 #: tail below the offset threshold).
 DISCHARGE_MARGIN = 0.5e-3
 #: Fewest samples before the contact's foot and after that margin for a measurement.
-DISCHARGE_MIN_SAMPLES = 5
+DISCHARGE_MIN_SAMPLES = 3
 #: Once restored, the gain stays while the median exceeds this many standard errors (hysteresis).
 DISCHARGE_HELD = 2.0
+#: From this many measurements on, the median's standard error is also read from their own scatter.
+DISCHARGE_SCATTER_FROM = 5
 #: 1/√(2/π): the standard error of a median over that of a mean, for normal scatter.
 MEDIAN_SE = 1.2533141373155001
 
@@ -219,7 +232,10 @@ F_HUM = 10                      # a_k, d_k for up to 4 harmonics
 # the offset that keeps the restored signal continuous where g changes [N], and the lane's last DISCHARGE_KEPT
 # measurements of the gain (values, then their standard errors)
 F_DIS, F_DPREV, F_DGAIN, F_DOFF = F_HUM + 8, F_HUM + 9, F_HUM + 10, F_HUM + 11
-F_DRING = F_HUM + 12
+# the quiet residual's running variance and lag-1 covariance (clipped at 3 σ) and its last value: how correlated the
+# noise is (a low-pass, the acquisition's anti-alias filter), for the discharge measurement's standard error
+F_C0, F_C1, F_RPREV = F_HUM + 12, F_HUM + 13, F_HUM + 14
+F_DRING = F_HUM + 15
 F_DRSE = F_DRING + DISCHARGE_KEPT
 F_FIFO = F_DRSE + DISCHARGE_KEPT
 FIFO_F = 4                      # peak value, baseline, noise, baseline slope
@@ -248,8 +264,14 @@ N_PI = 12
 
 #: The mains frequencies [Hz] ``find_mains_hum`` looks for.
 MAINS_FREQUENCIES = (50.0, 60.0)
-#: A mains hum is found when its fundamental's amplitude exceeds this many of its standard errors.
-HUM_SHOWN = 5.0
+#: The samples held to find the hum [s]: 10 cycles of 50 Hz, over which 50 and 60 Hz are orthogonal.
+HUM_WINDOW = 0.2
+#: The chance [-] that noise alone shows a hum, over every lane and both frequencies.
+HUM_FALSE_ALARM = 1e-6
+#: Around a contact in the window, this much [s] on each side is left out (its rise and its ringing).
+HUM_MASK = 0.015
+#: No hum below this amplitude [N] is removed (a constant lane's rounding is no hum).
+HUM_FLOOR = 1e-3
 #: E[min(|Z|, 3)] for a standard normal Z: the clipped mean absolute deviation of unit noise.
 CLIPPED_MAD = math.sqrt(2 / math.pi) * (1 - math.exp(-4.5)) + 3 * math.erfc(3 / math.sqrt(2))
 #: 1/Φ⁻¹(3/4): σ of normal noise from its median absolute deviation.
@@ -396,19 +418,31 @@ def _measure_discharge(lane, F, I, PF, IP, OW, off, ws, we, start, end, peak, si
     if not integral_post > 0.0:
         return False
     missing = -level_post / integral_post
-    error = sigma * math.sqrt(1.0 / n_post + 1.0 / n_pre) / integral_post
+    # the variance of a mean of n correlated samples: σ² (1 + ρ)/((1 − ρ) n) for noise of lag-1 correlation ρ (an
+    # AR(1) approximation of a low-passed noise), at most σ² (the samples no more than one)
+    rho = F[lane, F_C1] / F[lane, F_C0] if F[lane, F_C0] > 0.0 else 0.0
+    rho = min(max(rho, 0.0), 0.999)
+    factor = (1.0 + rho) / (1.0 - rho)
+    error = sigma * math.sqrt(min(1.0, factor / n_post) + min(1.0, factor / n_pre)) / integral_post
+    total = F[lane, F_DGAIN] + missing
+    if total > PF[PF_DCAP]:  # a discharge faster than MIN_DISCHARGE_TIME is no sensor's: a misread contact
+        return False
     count = I[lane, I_DN]
     slot = count % DISCHARGE_KEPT
-    F[lane, F_DRING + slot] = F[lane, F_DGAIN] + missing
+    F[lane, F_DRING + slot] = total
     F[lane, F_DRSE + slot] = error
     count += 1
     I[lane, I_DN] = count
     n = min(count, DISCHARGE_KEPT)
-    median = np.median(F[lane, F_DRING:F_DRING + n])
+    values = F[lane, F_DRING:F_DRING + n]
+    median = np.median(values)
     spread = MEDIAN_SE * np.median(F[lane, F_DRSE:F_DRSE + n]) / math.sqrt(n)
+    if n >= DISCHARGE_SCATTER_FROM:  # and never less than the measurements' own scatter says
+        scatter = MAD_TO_SIGMA * np.median(np.abs(values - median))
+        spread = max(spread, MEDIAN_SE * scatter / math.sqrt(n))
     # hysteresis: a gain restored stays while its median is above DISCHARGE_HELD errors (no flicker at the edge)
     shown = DISCHARGE_SHOWN if F[lane, F_DGAIN] == 0.0 else DISCHARGE_HELD
-    gain = min(median, PF[PF_DCAP]) if median > shown * spread and median > PF[PF_DFLOOR] else 0.0
+    gain = median if median > shown * spread and median > PF[PF_DFLOOR] else 0.0
     change = gain - F[lane, F_DGAIN]
     F[lane, F_DOFF] -= change * F[lane, F_DIS]
     F[lane, F_DGAIN] = gain
@@ -590,6 +624,10 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
                     if sig > 0.0 and a > 3.0 * sig:
                         a = 3.0 * sig
                     sig += a_s * (kc * a - sig)
+                    clipped = min(max(r, -3.0 * sig), 3.0 * sig)
+                    F[lane, F_C0] += a_s * (clipped * clipped - F[lane, F_C0])
+                    F[lane, F_C1] += a_s * (clipped * F[lane, F_RPREV] - F[lane, F_C1])
+                    F[lane, F_RPREV] = clipped
             elif state == S_IN:
                 r = z - (F[lane, F_CB] + F[lane, F_CD] * (gi - I[lane, I_START]))
                 if xv <= clip_lo or xv >= clip_hi:
@@ -610,6 +648,12 @@ def _run(x, pos, F, I, Z, R, WY, WC, WS, PF, IP, harm, sos, OF, OI, OW, cnt):
                     d = F[lane, F_CD]
                 elif gi - I[lane, I_START] + 1 >= maxlen:
                     _finish(lane, gi, False, True, F, I, IP)
+                    if PF[PF_DAUTO] > 0.0 and F[lane, F_DGAIN] != 0.0:
+                        # a contact that never ended under a measured restoration: the measurement was wrong
+                        # (restoring too much keeps the force above the baseline); it is dropped and measured anew
+                        F[lane, F_DOFF] += F[lane, F_DGAIN] * F[lane, F_DIS]
+                        F[lane, F_DGAIN] = 0.0
+                        I[lane, I_DN] = 0
                     state = S_WARM
                     I[lane, I_WARMN] = 0
             else:  # warm-up
@@ -711,6 +755,7 @@ class Detector:
                              0, self._maxwin, math.ceil(DISCHARGE_MARGIN * rate)], dtype=np.int64)
         self._sos = np.ascontiguousarray(sos)
         self._hum_auto = s.hum_frequency == HUM_AUTO
+        self._hum_window = max(warm_n, math.ceil(HUM_WINDOW * rate))
         self.hum_found: tuple | None = None
         self._set_hum(None if self._hum_auto else s.hum_frequency, gain)
         self._fifo, self._ring_len, self._warm_n = fifo, ring, warm_n
@@ -743,7 +788,7 @@ class Detector:
             self.hum_found = None
         self._F = np.zeros((lanes, F_FIFO + fifo * FIFO_F))
         self._F[:, F_PC] = 1.0
-        self._F[:, F_DGAIN] = self._discharge_gain
+        self._F[:, F_DGAIN] = self._pf[PF_DGAIN]
         self._I = np.zeros((lanes, I_FIFO + fifo * FIFO_I), dtype=np.int64)
         self._Z = np.zeros((lanes, max(self._sos.shape[0], 1), 2))
         self._R = np.zeros((lanes, self._ring_len))
@@ -759,8 +804,14 @@ class Detector:
     def discharge_time(self, lane: int) -> float | None:
         """τ [s] of the sensor discharge the lane restores now (step 1b: given, or measured on its contacts),
         None when it restores none."""
-        gain = float(self._F[lane, F_DGAIN])
-        return 1.0 / (gain * self.rate) if gain > 0.0 else None
+        return self._tau(float(self._F[lane, F_DGAIN]))
+
+    def _tau(self, gain: float) -> float | None:
+        """τ [s] of a restoration gain [1/samples]: the given one as given, a measured one, or None."""
+        if gain <= 0.0:
+            return None
+        given = self.settings.discharge_time
+        return given if given is not None and math.isfinite(given) else 1.0 / (gain * self.rate)
 
     @property
     def samples_fed(self) -> int:
@@ -771,18 +822,18 @@ class Detector:
         return sum(x.shape[0] for x in self._held) if self._hum_auto and self._held is not None else 0
 
     def _release(self, x: np.ndarray | None, final: bool = False) -> np.ndarray | None:
-        """With the hum found automatically: hold the samples until the first ``warmup`` are in, then find the
-        hum on them (``find_mains_hum``) and return everything held; at the stream's end (``final``) decide on what
+        """With the hum found automatically: hold the samples until the first ``HUM_WINDOW`` are in, then find
+        the hum on them (``find_mains_hum``) and return everything held; at the stream's end (``final``) decide on what
         there is.  Without: ``x`` itself."""
         if not self._hum_auto or self._held is None:
             return x
         if x is not None and x.shape[0]:
-            self._held.append(x)
-        if self._held_count() < self._warm_n and not final:
+            self._held.append(x.copy())  # the caller may reuse its buffer before the hum is found
+        if self._held_count() < self._hum_window and not final:
             return None
         held = np.concatenate(self._held) if self._held else np.zeros((0, self.lanes))
         self._held = None
-        self.hum_found = find_mains_hum(held[:self._warm_n], self.rate, self.settings.hum_harmonics)
+        self.hum_found = find_mains_hum(held[:self._hum_window], self.rate, self.settings.hum_harmonics)
         self._set_hum(self.hum_found[0])
         return held
 
@@ -861,50 +912,80 @@ class Detector:
                 next_start=None if row[O_NEXT] < 0 else row[O_NEXT],
                 clipped=bool(row[O_CLIP]), truncated=bool(row[O_TRUNC]), overlong=bool(row[O_LONG]),
                 window_start=row[O_WSTART], window=window, emitted_at=row[O_EMIT],
-                discharge_time=1.0 / (float(of[k, 4]) * self.rate) if of[k, 4] > 0.0 else None))
+                discharge_time=self._tau(float(of[k, 4]))))
         self._cnt[:] = 0
         return impacts
 
 
 def find_mains_hum(samples: np.ndarray, rate: float, harmonics=(1, 3)) -> tuple[float | None, float, float]:
-    """The mains hum in the quiet samples [N] (samples × lanes) at ``rate`` [Hz]: (50.0, 60.0 or None, the largest
-    fundamental amplitude [N] over the lanes, its standard error [N]).
+    """The mains hum in the first samples [N] (samples × lanes) at ``rate`` [Hz]: (50.0, 60.0 or None, the
+    fundamental's amplitude [N] on the lane that shows it best, its standard error [N]).
 
-    Each lane is fitted by least squares with a level, a slope and, for both 50 and 60 Hz, the cosine and sine of
-    each of ``harmonics`` below rate/2 (over the 50 ms warm-up, the two fundamentals are half a cycle apart and
-    separable: correlation 0.64).  A frequency is found when its fundamental's amplitude exceeds ``HUM_SHOWN``
-    standard errors σ √(2/n) (σ the fit's residual sd, n samples) and that of the other frequency; hum below that
-    (≤ 0.2 σ at 20 kHz) moves no result.  Fewer than 16 samples: none."""
+    Each lane's contacts are masked first (samples beyond 6 robust sd of the median, ±``HUM_MASK`` around them),
+    then the rest is fitted by least squares with a level, a slope, a curvature and, for both 50 and 60 Hz, the
+    cosine and sine of each of ``harmonics`` below rate/2.  A frequency is found where its fundamental's
+    (cos, sin) pair is significant against its own covariance from the fit, σ² (XᵀX)⁻¹ (χ² with 2 degrees of
+    freedom, beyond a false-alarm chance of ``HUM_FALSE_ALARM`` over every lane and both frequencies), more so than
+    the other frequency's, and above ``HUM_FLOOR``.  A lane with fewer than ``HUM_WINDOW`` / 2 of samples left, or
+    a window shorter than 2 cycles of 50 Hz, finds none."""
     x = np.asarray(samples, dtype=float)
     if x.ndim == 1:
         x = x[:, None]
-    n = x.shape[0]
-    if n < 16:
-        return None, 0.0, math.inf
+    n, lanes = x.shape
+    none = (None, 0.0, math.inf)
+    if n < 2 * rate / MAINS_FREQUENCIES[0]:
+        return none
     t = np.arange(n) / rate
-    columns = [np.ones(n), t - t.mean()]
-    fundamentals = {}
+    u = (t - t.mean()) / max(t[-1] - t[0], 1.0 / rate)
+    columns = [np.ones(n), u, u * u]
+    pairs = {}
     for frequency in MAINS_FREQUENCIES:
         for k in harmonics:
             if k * frequency < rate / 2:
-                if k == harmonics[0]:
-                    fundamentals[frequency] = len(columns)
+                if frequency not in pairs:
+                    pairs[frequency] = len(columns)
                 columns += [np.cos(2 * math.pi * k * frequency * t), np.sin(2 * math.pi * k * frequency * t)]
-    if not fundamentals:
-        return None, 0.0, math.inf
+    if not pairs:
+        return none
     design = np.column_stack(columns)
-    coefficients, *_ = np.linalg.lstsq(design, x, rcond=None)
-    residual = x - design @ coefficients
-    sigma = np.sqrt(np.sum(residual ** 2, axis=0) / max(n - design.shape[1], 1))
-    error = sigma * math.sqrt(2.0 / n)
-    amplitude = {f: np.hypot(coefficients[j], coefficients[j + 1]) for f, j in fundamentals.items()}
-    best = max(amplitude, key=lambda f: float(np.max(amplitude[f] / np.maximum(error, 1e-300))))
-    lane = int(np.argmax(amplitude[best] / np.maximum(error, 1e-300)))
-    found, size, spread = best, float(amplitude[best][lane]), float(error[lane])
-    others = [float(amplitude[f][lane]) for f in amplitude if f != best]
-    if not (size > HUM_SHOWN * spread and all(size > other for other in others)):
-        return None, size, spread
-    return found, size, spread
+    threshold = -2.0 * math.log(HUM_FALSE_ALARM / (len(pairs) * lanes))  # χ²₂ beyond it with that chance
+    best = none
+    best_stat = threshold
+    margin = int(math.ceil(HUM_MASK * rate))
+    for lane in range(lanes):
+        y = x[:, lane]
+        centre = float(np.median(y))
+        spread = MAD_TO_SIGMA * float(np.median(np.abs(y - centre)))
+        outside = np.abs(y - centre) > 6.0 * spread if spread > 0.0 else np.zeros(n, dtype=bool)
+        if outside.any():  # a contact in the window: it and its ringing are no hum
+            outside = np.convolve(outside, np.ones(2 * margin + 1), mode="same") > 0
+        keep = ~outside
+        if np.count_nonzero(keep) < max(n // 2, 2 * design.shape[1]):
+            continue
+        a, b = design[keep], y[keep]
+        coefficients, *_ = np.linalg.lstsq(a, b, rcond=None)
+        residual = b - a @ coefficients
+        dof = b.size - a.shape[1]
+        sigma2 = float(residual @ residual) / dof
+        try:
+            covariance = np.linalg.inv(a.T @ a)
+        except np.linalg.LinAlgError:
+            continue
+        stats = {}
+        for frequency, j in pairs.items():
+            beta = coefficients[j:j + 2]
+            block = covariance[j:j + 2, j:j + 2] * sigma2
+            try:
+                stats[frequency] = (float(beta @ np.linalg.solve(block, beta)), float(np.hypot(*beta)),
+                                    math.sqrt(0.5 * float(np.trace(block))))
+            except np.linalg.LinAlgError:
+                stats[frequency] = (0.0, 0.0, math.inf)
+        frequency = max(stats, key=lambda f: stats[f][0])
+        stat, amplitude, error = stats[frequency]
+        others = [stats[f][0] for f in stats if f != frequency]
+        if stat > best_stat and amplitude > HUM_FLOOR and all(stat > other for other in others):
+            best, best_stat = (frequency, amplitude, error), stat
+    return best
 
 
 def detect(force, rate: float, settings: DetectorSettings | None = None) -> list[DetectedImpact]:

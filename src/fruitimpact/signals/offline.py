@@ -33,7 +33,9 @@ def analyze(source, *, rate=None, column: str | None = None, format: str | None 
         Interleaved lanes of a raw float32 file.
     **options
         The analysis options of ``fruitimpact analyze`` by their Python names
-        (:data:`fruitimpact.signals.options.ANALYSIS_OPTIONS`): ``hum`` [Hz], ``lowpass`` [Hz], ``k_on``, ``k_off``,
+        (:data:`fruitimpact.signals.options.ANALYSIS_OPTIONS`): ``hum`` [Hz], ``"auto"`` (the default: 50 or 60 Hz
+        found on the first 0.2 s) or ``"none"``, ``lowpass`` [Hz], ``discharge_time`` [s] (a piezo sensor's),
+        ``"auto"`` (the default: measured on each lane's contacts) or ``"none"``, ``k_on``, ``k_off``,
         ``clip`` (``"LOW,HIGH"`` [N]), ``rebound_window`` [s], ``pitch`` [s] or ``fruit_rate`` [Hz], ``fit`` (bool),
         ``velocity`` [m/s] or ``drop_height`` [m], ``mass`` [kg], ``diameter`` [m], ``poisson``, ``sort_by``,
         ``thresholds`` (``"A,B"``), ``classes`` (``"soft,firm,…"``).  Numbers [SI] or strings with units.
