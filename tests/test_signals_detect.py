@@ -402,6 +402,29 @@ def test_the_mains_hum_is_found_on_the_first_samples(frequency):
         assert find_mains_hum(lanes, RATE)[0] is None
 
 
+@pytest.mark.parametrize("hum", [50.0, "auto"])
+def test_a_contact_in_the_warm_up_is_no_hum(hum):
+    """A fruit landing in the first 50 ms (the detector's warm-up, where the hum's level is fitted by least squares):
+    its pulse is left out of the fit (residuals beyond 6 robust sd, with a quarter of the warm-up each side) and the
+    fit done again, so the hum removed is the mains' and the fruit after it keep their peak force within 1 %.
+    Before, the pulse was fitted as hum: the next 0.3 s of fruit came out up to 17 % low (an attack on the CLI,
+    ``synth --interval 0.08 --hum 0.5``)."""
+    imp = hunt_crossley(0.19, 3.5e6, 1.0, 0.5)
+    n = 40_000
+    rng = np.random.default_rng(5)
+    t = np.arange(n) / RATE
+    x = 0.005 * imp["F"] * np.sin(2 * np.pi * 50.0 * t + 0.4) + rng.normal(0, 0.01 * imp["F"], n)
+    onsets = [0.02] + [0.1 + 0.08 * k for k in range(20)]
+    for onset in onsets:
+        idx, values = sensor_samples(imp, onset, n, plate=False)
+        x[idx] += values
+    impacts = detect(x, RATE, DetectorSettings(hum_frequency=hum, hum_harmonics=(1, 3)))
+    later = [i for i in impacts if i.start_index > 0.09 * RATE]
+    assert len(later) == 20
+    worst = max(abs(impact_indices(i, RATE)["peak_force"] / imp["F"] - 1) for i in later)
+    assert worst < 0.01, worst
+
+
 def test_a_hum_found_removes_what_a_hum_given_does(recording, detected):
     """``hum_frequency="auto"`` on the two 50 s lanes (hum at 50.1 Hz, 0.5 % of the median peak): 50 Hz is found on
     the first 0.2 s, and the impacts are those of the detector told 50 Hz, every field, fed in random chunks (the

@@ -270,6 +270,8 @@ HUM_WINDOW = 0.2
 HUM_FALSE_ALARM = 1e-6
 #: Around a contact in the window, this much [s] on each side is left out (its rise and its ringing).
 HUM_MASK = 0.015
+#: At most about this many samples per lane are fitted (a faster acquisition's are taken every k-th).
+HUM_SAMPLES = 40_000
 #: No hum below this amplitude [N] is removed (a constant lane's rounding is no hum).
 HUM_FLOOR = 1e-3
 #: E[min(|Z|, 3)] for a standard normal Z: the clipped mean absolute deviation of unit noise.
@@ -299,7 +301,9 @@ def _warm_fit(lane, gi, F, I, R, WY, WC, WS, harm, nh, L):
     """End of a warm-up: baseline level and slope and σ (MAD) from the warm-up samples.  Without hum
     removal the level and slope come from the medians of the two halves (robust); with it, from a
     least-squares fit of level, slope and hum terms, and the ring entries of the warm-up samples are
-    rewritten with the fitted hum removed.  The level is set for the next sample."""
+    rewritten with the fitted hum removed; a contact in the warm-up (residuals beyond 6 robust sd) is left out,
+    with a quarter of the warm-up on each side, and the fit done again (with less than half left: the robust
+    level and slope, no hum until the canceller learns it).  The level is set for the next sample."""
     wn = I[lane, I_WARMN]
     y = WY[lane, :wn]
     hc = np.empty(4)
@@ -319,35 +323,75 @@ def _warm_fit(lane, gi, F, I, R, WY, WC, WS, harm, nh, L):
         a = np.zeros((p, p))
         rhs = np.zeros(p)
         x = np.empty(p)
-        for i in range(wn):
-            _harmonic_terms(WC[lane, i], WS[lane, i], harm, hc, hs)
-            x[0] = 1.0
-            x[1] = i - mid
-            for j in range(nh):
-                x[2 + 2 * j] = hc[j]
-                x[3 + 2 * j] = hs[j]
-            for r in range(p):
-                rhs[r] += x[r] * y[i]
-                for c in range(p):
-                    a[r, c] += x[r] * x[c]
-        if not solve_small(a, rhs, p):
+        use = np.ones(wn, dtype=np.bool_)
+        robust = False
+        for attempt in range(2):  # a contact in the warm-up is no hum: left out, and the fit done again
+            a[:, :] = 0.0
             rhs[:] = 0.0
-            rhs[0] = np.median(y)
+            for i in range(wn):
+                if not use[i]:
+                    continue
+                _harmonic_terms(WC[lane, i], WS[lane, i], harm, hc, hs)
+                x[0] = 1.0
+                x[1] = i - mid
+                for j in range(nh):
+                    x[2 + 2 * j] = hc[j]
+                    x[3 + 2 * j] = hs[j]
+                for r in range(p):
+                    rhs[r] += x[r] * y[i]
+                    for c in range(p):
+                        a[r, c] += x[r] * x[c]
+            if not solve_small(a, rhs, p):
+                rhs[:] = 0.0
+                rhs[0] = np.median(y)
+            if attempt == 1:
+                break
+            for i in range(wn):
+                _harmonic_terms(WC[lane, i], WS[lane, i], harm, hc, hs)
+                h = 0.0
+                for j in range(nh):
+                    h += rhs[2 + 2 * j] * hc[j] + rhs[3 + 2 * j] * hs[j]
+                resid[i] = abs(y[i] - h - rhs[0] - rhs[1] * (i - mid))
+            spread = MAD_TO_SIGMA * np.median(resid)
+            limit = 6.0 * spread if spread > 0.0 else 1e-12 * (1.0 + np.max(np.abs(y)))
+            margin = wn // 4
+            outliers = 0
+            for i in range(wn):
+                if resid[i] > limit:
+                    outliers += 1
+                    for k in range(max(i - margin, 0), min(i + margin + 1, wn)):
+                        use[k] = False
+            if outliers == 0:
+                break
+            if np.count_nonzero(use) < wn // 2:  # too little left for the hum: the robust level and slope alone
+                robust = True
+                break
+        if robust:
+            half = wn // 2
+            m1 = np.median(y[:half])
+            m2 = np.median(y[wn - half:])
+            rhs[:] = 0.0
+            rhs[1] = (m2 - m1) / (wn - half)
+            rhs[0] = 0.5 * (m1 + m2)
         level = rhs[0]
         d = rhs[1]
         for j in range(nh):
             F[lane, F_HUM + 2 * j] = rhs[2 + 2 * j]
             F[lane, F_HUM + 2 * j + 1] = rhs[3 + 2 * j]
         first = gi - wn + 1
+        kept = 0
         for i in range(wn):
             _harmonic_terms(WC[lane, i], WS[lane, i], harm, hc, hs)
             h = 0.0
             for j in range(nh):
                 h += rhs[2 + 2 * j] * hc[j] + rhs[3 + 2 * j] * hs[j]
             z = y[i] - h
-            resid[i] = abs(z - level - d * (i - mid))
+            if robust or use[i]:  # σ from the samples the fit used: a contact left out is no noise
+                resid[kept] = abs(z - level - d * (i - mid))
+                kept += 1
             if gi - (first + i) < L:
                 R[lane, (first + i) % L] = z
+        resid = resid[:kept]
     F[lane, F_B] = level + d * (wn - mid)
     F[lane, F_D] = d
     F[lane, F_SIG] = MAD_TO_SIGMA * np.median(resid)
@@ -931,10 +975,12 @@ def find_mains_hum(samples: np.ndarray, rate: float, harmonics=(1, 3)) -> tuple[
     x = np.asarray(samples, dtype=float)
     if x.ndim == 1:
         x = x[:, None]
-    n, lanes = x.shape
     none = (None, 0.0, math.inf)
-    if n < 2 * rate / MAINS_FREQUENCIES[0]:
+    if x.shape[0] < 2 * rate / MAINS_FREQUENCIES[0]:
         return none
+    stride = max(1, x.shape[0] // HUM_SAMPLES)  # 0.2 s at 10 MHz: every k-th sample, ≥ 100 per mains cycle
+    x, rate = x[::stride], rate / stride
+    n, lanes = x.shape
     t = np.arange(n) / rate
     u = (t - t.mean()) / max(t[-1] - t[0], 1.0 / rate)
     columns = [np.ones(n), u, u * u]
@@ -956,7 +1002,9 @@ def find_mains_hum(samples: np.ndarray, rate: float, harmonics=(1, 3)) -> tuple[
         y = x[:, lane]
         centre = float(np.median(y))
         spread = MAD_TO_SIGMA * float(np.median(np.abs(y - centre)))
-        outside = np.abs(y - centre) > 6.0 * spread if spread > 0.0 else np.zeros(n, dtype=bool)
+        # a quantised quiet signal has no spread: then any departure from it is a contact
+        limit = 6.0 * spread if spread > 0.0 else 1e-12 * (1.0 + float(np.max(np.abs(y))))
+        outside = np.abs(y - centre) > limit
         if outside.any():  # a contact in the window: it and its ringing are no hum
             outside = np.convolve(outside, np.ones(2 * margin + 1), mode="same") > 0
         keep = ~outside

@@ -66,6 +66,10 @@ def _setting_error(exc: ValueError) -> InputError:
     return _refusal(option, text) if option else InputError(text)
 
 
+#: The mains frequencies ``--hum`` accepts [Hz]: 16.7 Hz railway supplies to 400 Hz aircraft ones.
+HUM_RANGE = (16.0, 400.0)
+
+
 def parse_hum(text) -> float | str | None:
     """``--hum``: ``auto`` (the default: 50 or 60 Hz found on the stream's first samples, or none), ``none`` (None)
     or the mains frequency [Hz]."""
@@ -75,9 +79,10 @@ def parse_hum(text) -> float | str | None:
     if word == "none":
         return None
     try:
-        return _number("--hum", text, "frequency")
+        return _number("--hum", text, "frequency", low=HUM_RANGE[0], low_inclusive=True, high=HUM_RANGE[1])
     except InputError:
-        raise _refusal("--hum", f"must be auto, none or the mains frequency in Hz (50 or 60); got {text!r}") from None
+        raise _refusal("--hum", f"must be auto, none or the mains frequency in [{HUM_RANGE[0]:g}, {HUM_RANGE[1]:g}] Hz "
+                                f"(50 or 60); got {text!r}") from None
 
 
 def parse_discharge(text) -> float | None:
