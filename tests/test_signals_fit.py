@@ -528,3 +528,77 @@ def test_the_compiled_sum_fit_agrees_with_levenberg_marquardt():
     theta, *_, compiled_converged, _ = fit_pulse_sum(t, force, weights, start, index, mean, weight)
     assert converged and compiled_converged
     assert np.allclose(theta, expected, rtol=1e-6, atol=1e-9), theta - expected
+
+
+def test_the_starts_pair_table_is_linear_least_squares():
+    """split._pair_table (the compiled grid of starts of a joint fit) solves each pair of unit pulses for its two
+    peaks by linear least squares: against NumPy's lstsq on the same two shifted columns, peaks to 1e-9 and χ² to
+    1e-9 (the same normal equations summed in another order); the prior χ² of a pair with an expected rebound is
+    Σ ((θ − μ)/sd)² over (ln F_max, ln T, x) of the pulse it names; pairs whose peak is below the floor score inf."""
+    from fruitimpact.signals.pulse import PulseModel
+    from fruitimpact.signals.split import _pair_table
+
+    t, force, truth = _two_pulses(0.01)
+    ts = t - t[0]
+    noise = 0.01 * PEAK
+    model = PulseModel(ts)
+    shapes = [(0.6 * DURATION, 1.0), (0.8 * DURATION, 1.0), (math.exp(truth[6]), truth[7])]
+    units = np.array([model.pulse((0.0, 0.0, math.log(d), x)).copy() for d, x in shapes])
+    first, grid = 38, np.arange(45, 200, 12)
+    priors = np.array([[truth[5], truth[6], truth[7], 0.1, 0.05, 0.2]])
+    floor = 3 * noise
+    table, theta, score, on = _pair_table(ts, force, noise, units, first, grid, np.array([d for d, _ in shapes]),
+                                          np.array([x for _, x in shapes]), 2, priors, floor)
+    assert len(table) == grid.size * 2 * 2 + 2 * grid.size * 2
+    checked = 0
+    for j in range(len(table)):
+        columns = []
+        for unit, onset in ((int(table[j, 0]) // (grid.size + 1), first),
+                            (int(table[j, 1]) // (grid.size + 1), int(table[j, 8]))):
+            column = np.zeros(ts.size)
+            column[onset:] = units[unit][:ts.size - onset]
+            columns.append(column)
+        a = np.column_stack(columns)
+        peaks, *_ = np.linalg.lstsq(a, force, rcond=None)
+        chi2 = float(np.sum((a @ peaks - force) ** 2)) / noise ** 2
+        if min(peaks) <= floor:
+            assert score[j] == math.inf
+            continue
+        each = [float(np.sum(((theta[j, [4 * p + 1, 4 * p + 2, 4 * p + 3]] - priors[0, :3]) / priors[0, 3:]) ** 2))
+                for p in (0, 1)]
+        prior = min(each) if table[j, 6] < 0 else each[int(table[j, 7])]  # a generic pair: the nearer pulse
+        assert each[on[j, 1]] == prior
+        assert np.allclose(np.exp(theta[j, [1, 5]]), peaks, rtol=1e-9)
+        assert score[j] == pytest.approx(chi2 + prior, rel=1e-9)
+        assert theta[j, 0] == ts[first] and theta[j, 4] == ts[int(table[j, 8])]
+        checked += 1
+    assert checked > 20
+
+
+def test_the_starts_fitted_side_by_side_choose_as_one_thread_does(monkeypatch):
+    """split.split_contact fits its starts on worker threads (PARALLEL_FITS) and takes their results in the
+    starts' order: on two pulses 0.5-2 ms apart with noise, with and without an expected rebound, the separation
+    is the one a single thread finds, to the last bit."""
+    from fruitimpact.signals import split
+
+    cases = []
+    for gap in (0.0005, 0.001, 0.002):
+        t, force, truth = _two_pulses(0.01, gap=gap)
+        expected = {"log_peak": truth[5], "log_duration": truth[6], "x": truth[7], "log_peak_sd": 0.1,
+                    "log_duration_sd": 0.05, "x_sd": 0.2}
+        cases += [(t, force, ()), (t, force, (expected,))]
+    results = {}
+    for workers in (1, 2, 4):
+        monkeypatch.setattr(split, "PARALLEL_FITS", workers)
+        results[workers] = [split.split_contact(t, force, 0.01 * PEAK, velocity=VELOCITY, expected=expected)
+                            for t, force, expected in cases]
+    assert any(parts is not None for parts in results[1])
+    for workers in (2, 4):
+        for one, many in zip(results[1], results[workers]):
+            assert (one is None) == (many is None)
+            if one is not None:
+                for (fit_one, force_one), (fit_many, force_many) in zip(one, many):
+                    assert np.array_equal(force_one, force_many)
+                    assert all(fit_one[key] == fit_many[key] or (fit_one[key] != fit_one[key]
+                                                                 and fit_many[key] != fit_many[key])
+                               for key in fit_one)

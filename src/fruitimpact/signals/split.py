@@ -15,7 +15,10 @@ with the contact, the second anywhere in it, each 55–85 % of the contact's spa
 from linear least squares, and ``fits`` of them are fitted (the best of each hypothesis first; a pair with an
 expected rebound's own pulse is one hypothesis per duration of the fruit beside it).  With a rebound due, a fit
 that leaves only the noise (``GOOD_MISFIT``, and a χ² within ``NOISE_CHI2_SD`` of the samples') and agrees with
-the rebound ends the search.
+the rebound ends the search.  The pairs of the grid are solved by one compiled routine (``_pair_table``), and the
+starts' fits run side by side on worker threads (``PARALLEL_FITS``; the compiled iteration releases the GIL),
+their results taken in the starts' order so that the choice is the one a single thread makes: a contact holding
+two pulses is the tail of a stream's latency (benchmarks/latency.py).
 
 Choice.  The first pulse's tail lies under the second, so several fits can leave the same residual (two fits
 of one overlap: e 0.34 with 94.6 N, or e 0.71 with 99.9 N).  Physics chooses.  When an earlier fruit's rebound
@@ -37,9 +40,15 @@ them).  Otherwise the contact stays one report with status ``overlap`` (``analys
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import closing
+from functools import partial
 
+import numba as nb
 import numpy as np
 
+from fruitimpact.engine.jitcache import CACHE
 from fruitimpact.engine.powerlaw import restitution_of_x
 from fruitimpact.signals.fit import MIN_PEAK_SNR, RESULT_KEYS, named_result
 from fruitimpact.signals.leastsquares import fit_pulse_sum
@@ -64,6 +73,10 @@ GRID_DURATIONS = (0.55, 0.7, 0.85)
 #: rebound is due (``FITS_DUE``: most contacts of a busy line; each fit costs 2–5 ms).
 FITS = 4
 FITS_DUE = 4
+#: Joint fits run side by side, each start on its own thread (the compiled iteration releases the GIL): as many
+#: as the process may use cores, up to ``FITS``.  The results are taken in the starts' order, whatever finishes
+#: first, so the choice is the one a single thread makes (1: one after the other, on the calling thread).
+PARALLEL_FITS = min(FITS, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 #: A fit whose prior χ² (three parameters) is within this (the 95 % point of χ² with 3 degrees of freedom) agrees
 #: with the expected rebound.
 PLAUSIBLE_PRIOR_CHI2 = 7.81
@@ -151,15 +164,17 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
     weights = np.full(ts.shape, 1.0 / noise)
     args = (velocity if mass is None else None, mass, diameter, poisson)
     found = []
-    for theta, prior in _starts(ts, y, noise, _landmarks(y) if dip else None, expected, fits):
-        fit = _separated(model, ts, y, noise, weights, theta, args, t_ref, prior)
-        if fit is None:
-            continue
-        found.append(fit)
-        prior_chi2 = prior.chi2(fit[2]) if prior is not None else math.inf
-        if prior_chi2 <= PLAUSIBLE_PRIOR_CHI2 and fit[1] <= GOOD_MISFIT \
-                and fit[0] - prior_chi2 <= ts.size + NOISE_CHI2_SD * math.sqrt(2.0 * ts.size):
-            break  # it leaves only the noise and one pulse is the rebound that was due: taken (latency)
+    starts = _starts(ts, y, noise, _landmarks(y) if dip else None, expected, fits)
+    with closing(_in_order([partial(_joint_fit, ts, y, weights, theta, prior) for theta, prior in starts])) as fitted:
+        for (_, prior), result in zip(starts, fitted):
+            fit = _separated(model, ts, y, noise, result, prior)
+            if fit is None:
+                continue
+            found.append(fit)
+            prior_chi2 = prior.chi2(fit[2]) if prior is not None else math.inf
+            if prior_chi2 <= PLAUSIBLE_PRIOR_CHI2 and fit[1] <= GOOD_MISFIT \
+                    and fit[0] - prior_chi2 <= ts.size + NOISE_CHI2_SD * math.sqrt(2.0 * ts.size):
+                break  # it leaves only the noise and one pulse is the rebound that was due: taken (latency)
     if not found:
         return None
     # the least χ² (with a rebound due, the posterior: the data's χ² and the prior's); of fits alike in it, the one
@@ -200,13 +215,43 @@ def _implausibility(theta, restitution) -> float:
     return sum(max(0.0, restitution - RESTITUTION_SPREAD - restitution_of_x(float(x))) for x in theta[3::4])
 
 
-def _separated(model, ts, y, noise, weights, theta, args, t_ref, prior=None):
-    """(χ², misfit, θ, covariance, rms, iterations) of the joint fit started at ``theta`` when it is accepted
-    (module docstring), else None."""
+def _joint_fit(ts, y, weights, theta, prior):
+    """``fit_pulse_sum`` of two pulses from the start ``theta`` with its prior (None: none).  Safe on any thread:
+    it shares no buffer (``_separated`` then judges the result on the calling thread, with the model's)."""
     with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
-        theta, jac, _, iterations, converged, _ = fit_pulse_sum(
-            ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
-            max_iterations=SPLIT_ITERATIONS)
+        return fit_pulse_sum(ts, y, weights, theta,
+                             *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
+                             max_iterations=SPLIT_ITERATIONS)
+
+
+_POOL: dict = {}
+
+
+def _in_order(jobs: list):
+    """The results of ``jobs`` (callables) in their order, computed up to ``PARALLEL_FITS`` at a time on worker
+    threads; those not yet begun are cancelled when the caller stops early (``closing``).  A forked child (the web
+    app's workers) gets its own pool: the parent's threads do not exist there."""
+    if PARALLEL_FITS < 2 or len(jobs) < 2:
+        for job in jobs:
+            yield job()
+        return
+    pool = _POOL.get(os.getpid())
+    if pool is None:
+        _POOL.clear()
+        pool = _POOL[os.getpid()] = ThreadPoolExecutor(PARALLEL_FITS, thread_name_prefix="fruitimpact-fit")
+    futures = [pool.submit(job) for job in jobs]
+    try:
+        for future in futures:
+            yield future.result()
+    finally:
+        for future in futures:
+            future.cancel()
+
+
+def _separated(model, ts, y, noise, result, prior=None):
+    """(χ², misfit, θ, covariance, rms, iterations) of a joint fit (``_joint_fit``'s result) when it is accepted
+    (module docstring), else None."""
+    theta, jac, _, iterations, converged, _ = result
     if not np.all(np.isfinite(theta)):
         return None
     try:  # a degenerate pulse (a peak or duration beyond double precision) is a failed separation
@@ -272,79 +317,21 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
     grid = np.unique(np.linspace(first + 3, last, GRID_ONSETS).round().astype(int))
     grid = [int(k) for k in grid[grid < n]]
     model = PulseModel(ts - ts[0])
-    # the unit pulses (peak 1): each shape (duration, x) once, shifted to each onset (the contact's first sample
-    # and the grid); row of (shape s, onset o) = s × onsets + o
+    # the unit pulses (peak 1): each shape (duration, x) once, at the window's first sample; the compiled kernel
+    # shifts them to each onset and solves every pair
     shapes = [(duration, 1.0) for duration in durations] + \
         [(math.exp(guess["log_duration"]), guess["x"]) for guess in expected]
-    onsets = [first, *grid]
-    matrix = np.zeros((len(shapes) * len(onsets), n))
+    units = np.empty((len(shapes), n))
     for s_index, (duration, x) in enumerate(shapes):
-        shape = model.pulse((0.0, 0.0, math.log(duration), x))
-        for o_index, at in enumerate(onsets):
-            matrix[s_index * len(onsets) + o_index, at:] = shape[:n - at]
-    n_d, n_g, n_o = len(durations), len(grid), len(onsets)
-    generic = np.arange(n_d)
-    grid_rows = np.arange(1, n_o)
-
-    def row(shape_index, onset_index):
-        return shape_index * n_o + onset_index
-
-    # the pairs of unit pulses, one per row of ``table``, in the order of the loops they replace: (row A, row B,
-    # duration A, duration B, x A, x B, expected k or −1, the pulse it is, B's onset sample); A starts with the contact
-    blocks = []
-    at_g, da_g, db_g = np.meshgrid(np.arange(n_g), generic, generic, indexing="ij")  # at, duration A, duration B
-    at_g, da_g, db_g = at_g.ravel(), da_g.ravel(), db_g.ravel()
-    blocks.append(np.column_stack([row(da_g, 0), row(db_g, grid_rows[at_g]), np.take(durations, da_g),
-                                   np.take(durations, db_g), np.ones(at_g.size), np.ones(at_g.size),
-                                   np.full(at_g.size, -1.0), np.zeros(at_g.size), np.take(grid, at_g)]))
-    for k in range(len(expected)):
-        duration_r, x_r = shapes[n_d + k]
-        at_k, d_k = np.meshgrid(np.arange(n_g), generic, indexing="ij")
-        at_k, d_k = at_k.ravel(), d_k.ravel()
-        size = at_k.size
-        fruit_first = np.column_stack([row(d_k, 0), row(n_d + k, grid_rows[at_k]), np.take(durations, d_k),
-                                       np.full(size, duration_r), np.ones(size), np.full(size, x_r),
-                                       np.full(size, float(k)), np.ones(size), np.take(grid, at_k)])
-        rebound_first = np.column_stack([np.full(size, row(n_d + k, 0)), row(d_k, grid_rows[at_k]),
-                                         np.full(size, duration_r), np.take(durations, d_k), np.full(size, x_r),
-                                         np.ones(size), np.full(size, float(k)), np.zeros(size),
-                                         np.take(grid, at_k)])
-        pairs_k = np.empty((2 * size, 9))
-        pairs_k[0::2], pairs_k[1::2] = fruit_first, rebound_first
-        blocks.append(pairs_k)
-    table = np.concatenate(blocks)
-    a, b = table[:, 0].astype(int), table[:, 1].astype(int)
-    # row by row (einsum's own loops: a BLAS product this small would wake BLAS's threads, which then spin
-    # beside the stream on a small machine)
-    norms, projection = np.einsum("ij,ij->i", matrix, matrix), np.einsum("ij,j->i", matrix, y)
-    aa, bb, ay, by = norms[a], norms[b], projection[a], projection[b]
-    ab = np.einsum("ij,ij->i", matrix[a], matrix[b])
-    with np.errstate(all="ignore"):
-        det = aa * bb - ab * ab
-        peak_a, peak_b = (ay * bb - by * ab) / det, (by * aa - ay * ab) / det
-        chi2 = (y @ y - 2.0 * (peak_a * ay + peak_b * by) + peak_a ** 2 * aa + 2.0 * peak_a * peak_b * ab
-                + peak_b ** 2 * bb) / noise ** 2
-        # a second pulse below a tenth of the contact's peak is the noise or the plate's ringing, not a fruit (a
-        # rebound lands with ≥ 20 % of a fruit's peak): such pairs would only waste a fit
-        floor = max(level, MIN_SHARE * float(y[top]))
-        good = (det > 1e-12 * aa * bb) & (peak_a > floor) & (peak_b > floor)
-        log_a, log_b = np.log(np.where(good, peak_a, 1.0)), np.log(np.where(good, peak_b, 1.0))
-    theta = np.column_stack([np.full(len(table), ts[first]), log_a, np.log(table[:, 2]), table[:, 4],
-                             ts[table[:, 8].astype(int)], log_b, np.log(table[:, 3]), table[:, 5]])
-    prior_chi2 = np.zeros(len(table))
-    on = np.full((len(table), 2), -1)  # (expected k, pulse) of each pair's prior
-    if expected:
-        best = np.full(len(table), np.inf)
-        for k, guess in enumerate(expected):
-            for pulse in (0, 1):
-                value = sum(((theta[:, 4 * pulse + 1 + i] - guess[key]) / guess[f"{key}_sd"]) ** 2
-                            for i, key in enumerate(_Prior.KEYS))
-                own = table[:, 6] == k
-                value = np.where((table[:, 6] < 0) | (own & (table[:, 7] == pulse)), value, np.inf)
-                take = value < best
-                best[take], on[take] = value[take], (k, pulse)
-        prior_chi2 = best
-    score = np.where(good, chi2 + prior_chi2, np.inf)
+        units[s_index] = model.pulse((0.0, 0.0, math.log(duration), x))
+    priors = np.array([[guess[key] for key in _Prior.KEYS] + [guess[f"{key}_sd"] for key in _Prior.KEYS]
+                       for guess in expected], dtype=float).reshape(len(expected), 6)
+    # a second pulse below a tenth of the contact's peak is the noise or the plate's ringing, not a fruit (a
+    # rebound lands with ≥ 20 % of a fruit's peak): such pairs would only waste a fit
+    floor = max(level, MIN_SHARE * float(y[top]))
+    table, theta, score, on = _pair_table(ts, y, noise, units, first, np.array(grid, dtype=np.int64),
+                                          np.array([duration for duration, _ in shapes]),
+                                          np.array([x for _, x in shapes]), len(durations), priors, floor)
     ranked = np.argsort(score, kind="stable")
     ranked = ranked[np.isfinite(score[ranked])]
     # the best start of each hypothesis (which expected rebound is which pulse, with that rebound's own pulse or
@@ -372,6 +359,102 @@ def _starts(ts: np.ndarray, y: np.ndarray, noise: float, marks, expected=(), lim
         prior = _Prior(expected[on[i, 0]], int(on[i, 1])) if on[i, 0] >= 0 else None
         starts.append((theta[i].copy(), prior))
     return starts[:limit]
+
+
+@nb.njit(cache=CACHE, error_model="numpy")
+def _pair_table(ts, y, noise, units, first, grid, shape_durations, shape_x, n_generic, priors, floor):
+    """The pairs of unit pulses of ``_starts``, solved (compiled: this was ~40 NumPy calls and 0.5–1.9 ms per
+    contact, on the tail of a stream's latency).  ``units``: the unit pulses (peak 1) starting at ts[0], the first
+    ``n_generic`` of the grid's durations (x = 1), then one per expected rebound; ``priors``: per expected rebound
+    the means and sds of (ln F_max, ln T, x).  Pulse A starts at sample ``first``, pulse B at a ``grid`` sample.
+
+    Returns (table, θ, score, on): per pair a row of ``table`` (unit row A, unit row B, duration A, duration B,
+    x A, x B, expected k or −1, which pulse the expected one is, B's onset sample), its start θ (the two peaks by
+    linear least squares), its score (χ² of the samples plus the prior's; inf when a peak is below ``floor`` or
+    the pair is degenerate) and (k, pulse) of its prior (−1, −1 without).  The rows come in the order of the
+    loops: the generic pairs by (onset, duration A, duration B), then per expected rebound, by (onset, duration of
+    the fruit beside it), the pair with the fruit first and the pair with the rebound first."""
+    n = ts.shape[0]
+    n_g = grid.shape[0]
+    n_o = n_g + 1
+    n_e = priors.shape[0]
+    onsets = np.empty(n_o, np.int64)
+    onsets[0] = first
+    onsets[1:] = grid
+    # each unit pulse shifted to each onset: row (shape s, onset o) = s × n_o + o
+    n_rows = units.shape[0] * n_o
+    matrix = np.zeros((n_rows, n))
+    for s_index in range(units.shape[0]):
+        for o_index in range(n_o):
+            at = onsets[o_index]
+            for i in range(at, n):
+                matrix[s_index * n_o + o_index, i] = units[s_index, i - at]
+    norms, projection = np.empty(n_rows), np.empty(n_rows)
+    for r in range(n_rows):
+        aa, ay = 0.0, 0.0
+        for i in range(n):
+            aa += matrix[r, i] * matrix[r, i]
+            ay += matrix[r, i] * y[i]
+        norms[r], projection[r] = aa, ay
+    yy = 0.0
+    for i in range(n):
+        yy += y[i] * y[i]
+    n_pairs = n_g * n_generic * n_generic + n_e * 2 * n_g * n_generic
+    table = np.empty((n_pairs, 9))
+    j = 0
+    for at in range(n_g):
+        for da in range(n_generic):
+            for db in range(n_generic):
+                table[j, 0], table[j, 1] = da * n_o, db * n_o + 1 + at
+                table[j, 2], table[j, 3] = shape_durations[da], shape_durations[db]
+                table[j, 4], table[j, 5], table[j, 6], table[j, 7] = 1.0, 1.0, -1.0, 0.0
+                table[j, 8] = grid[at]
+                j += 1
+    for k in range(n_e):
+        own = n_generic + k
+        for at in range(n_g):
+            for d in range(n_generic):
+                table[j, 0], table[j, 1] = d * n_o, own * n_o + 1 + at  # the fruit first
+                table[j, 2], table[j, 3] = shape_durations[d], shape_durations[own]
+                table[j, 4], table[j, 5], table[j, 6], table[j, 7] = 1.0, shape_x[own], k, 1.0
+                table[j, 8] = grid[at]
+                table[j + 1, 0], table[j + 1, 1] = own * n_o, d * n_o + 1 + at  # the rebound first
+                table[j + 1, 2], table[j + 1, 3] = shape_durations[own], shape_durations[d]
+                table[j + 1, 4], table[j + 1, 5], table[j + 1, 6], table[j + 1, 7] = shape_x[own], 1.0, k, 0.0
+                table[j + 1, 8] = grid[at]
+                j += 2
+    theta = np.empty((n_pairs, 8))
+    score = np.empty(n_pairs)
+    on = np.full((n_pairs, 2), -1, np.int64)
+    for j in range(n_pairs):
+        a, b = int(table[j, 0]), int(table[j, 1])
+        ab = 0.0
+        for i in range(n):
+            ab += matrix[a, i] * matrix[b, i]
+        aa, bb, ay, by = norms[a], norms[b], projection[a], projection[b]
+        det = aa * bb - ab * ab
+        peak_a, peak_b = (ay * bb - by * ab) / det, (by * aa - ay * ab) / det
+        chi2 = (yy - 2.0 * (peak_a * ay + peak_b * by) + peak_a ** 2 * aa + 2.0 * peak_a * peak_b * ab
+                + peak_b ** 2 * bb) / noise ** 2
+        good = det > 1e-12 * aa * bb and peak_a > floor and peak_b > floor
+        theta[j, 0], theta[j, 1] = ts[first], math.log(peak_a) if good else 0.0
+        theta[j, 2], theta[j, 3] = math.log(table[j, 2]), table[j, 4]
+        theta[j, 4], theta[j, 5] = ts[int(table[j, 8])], math.log(peak_b) if good else 0.0
+        theta[j, 6], theta[j, 7] = math.log(table[j, 3]), table[j, 5]
+        # the prior of the expected pulse nearest either pulse (a generic pair) or of its own (a pair with it)
+        best = math.inf if n_e else 0.0
+        for k in range(n_e):
+            for pulse in range(2):
+                if not (table[j, 6] < 0 or (table[j, 6] == k and table[j, 7] == pulse)):
+                    continue
+                value = 0.0
+                for i in range(3):
+                    value += ((theta[j, 4 * pulse + 1 + i] - priors[k, i]) / priors[k, 3 + i]) ** 2
+                if value < best:
+                    best = value
+                    on[j, 0], on[j, 1] = k, pulse
+        score[j] = chi2 + best if good else math.inf
+    return table, theta, score, on
 
 
 def _nearest_prior(theta, expected) -> _Prior | None:
