@@ -531,12 +531,12 @@ def test_the_compiled_sum_fit_agrees_with_levenberg_marquardt():
 
 
 def test_the_starts_pair_table_is_linear_least_squares():
-    """split._pair_table (the compiled grid of starts of a joint fit) solves each pair of unit pulses for its two
+    """starts._pair_table (the compiled grid of starts of a joint fit) solves each pair of unit pulses for its two
     peaks by linear least squares: against NumPy's lstsq on the same two shifted columns, peaks to 1e-9 and χ² to
     1e-9 (the same normal equations summed in another order); the prior χ² of a pair with an expected rebound is
     Σ ((θ − μ)/sd)² over (ln F_max, ln T, x) of the pulse it names; pairs whose peak is below the floor score inf."""
     from fruitimpact.signals.pulse import PulseModel
-    from fruitimpact.signals.split import _pair_table
+    from fruitimpact.signals.starts import _pair_table
 
     t, force, truth = _two_pulses(0.01)
     ts = t - t[0]
