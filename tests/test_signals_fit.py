@@ -573,32 +573,3 @@ def test_the_starts_pair_table_is_linear_least_squares():
         assert theta[j, 0] == ts[first] and theta[j, 4] == ts[int(table[j, 8])]
         checked += 1
     assert checked > 20
-
-
-def test_the_starts_fitted_side_by_side_choose_as_one_thread_does(monkeypatch):
-    """split.split_contact fits its starts on worker threads (PARALLEL_FITS) and takes their results in the
-    starts' order: on two pulses 0.5-2 ms apart with noise, with and without an expected rebound, the separation
-    is the one a single thread finds, to the last bit."""
-    from fruitimpact.signals import split
-
-    cases = []
-    for gap in (0.0005, 0.001, 0.002):
-        t, force, truth = _two_pulses(0.01, gap=gap)
-        expected = {"log_peak": truth[5], "log_duration": truth[6], "x": truth[7], "log_peak_sd": 0.1,
-                    "log_duration_sd": 0.05, "x_sd": 0.2}
-        cases += [(t, force, ()), (t, force, (expected,))]
-    results = {}
-    for workers in (1, 2, 4):
-        monkeypatch.setattr(split, "PARALLEL_FITS", workers)
-        results[workers] = [split.split_contact(t, force, 0.01 * PEAK, velocity=VELOCITY, expected=expected)
-                            for t, force, expected in cases]
-    assert any(parts is not None for parts in results[1])
-    for workers in (2, 4):
-        for one, many in zip(results[1], results[workers]):
-            assert (one is None) == (many is None)
-            if one is not None:
-                for (fit_one, force_one), (fit_many, force_many) in zip(one, many):
-                    assert np.array_equal(force_one, force_many)
-                    assert all(fit_one[key] == fit_many[key] or (fit_one[key] != fit_one[key]
-                                                                 and fit_many[key] != fit_many[key])
-                               for key in fit_one)

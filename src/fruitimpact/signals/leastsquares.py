@@ -174,7 +174,7 @@ def _sum_residuals(t, y, weights, theta, coefficients, width, prior_index, prior
             jac[n + k, prior_index[k]] = prior_weight[k]
 
 
-@nb.njit(cache=CACHE, error_model="numpy", nogil=True)  # without the GIL: the starts of a joint fit run side by side
+@nb.njit(cache=CACHE, error_model="numpy")
 def _lm_pulse_sum(t, y, weights, theta, coefficients, width, prior_index, prior_mean, prior_weight, max_iterations,
                   step_tolerance, x_max):
     """``levenberg_marquardt`` for a sum of pulses with Gaussian priors on some parameters, compiled: the same

@@ -11,10 +11,10 @@ compiled for a sum of pulses (``leastsquares.fit_pulse_sum``).
 Starts.  Two pulses a few milliseconds apart show no dip, so the fit is started from several places
 (``signals.starts``: the landmarks of a dip, then the best pulse pairs of a grid, the best of each hypothesis
 first) and ``fits`` of them are fitted.  With a rebound due, a fit that leaves only the noise (``GOOD_MISFIT``,
-and a χ² within ``NOISE_CHI2_SD`` of the samples') and agrees with the rebound ends the search.  The starts'
-fits run side by side on worker threads (``PARALLEL_FITS``; the compiled iteration releases the GIL), their
-results taken in the starts' order so that the choice is the one a single thread makes: a contact holding two
-pulses is the tail of a stream's latency (benchmarks/latency.py).
+and a χ² within ``NOISE_CHI2_SD`` of the samples') and agrees with the rebound ends the search.  The fits run
+one after the other on the calling thread: on two worker threads (the results taken in the starts' order, so
+the same choice) a 2-core machine gained ~0.5 ms at the 1-lane p99 of benchmarks/latency.py when idle and lost
+3-6 ms with another process busy on the second core (docs/performance.md).
 
 Choice.  The first pulse's tail lies under the second, so several fits can leave the same residual (two fits
 of one overlap: e 0.34 with 94.6 N, or e 0.71 with 99.9 N).  Physics chooses.  When an earlier fruit's rebound
@@ -36,10 +36,6 @@ them).  Otherwise the contact stays one report with status ``overlap`` (``analys
 from __future__ import annotations
 
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import closing
-from functools import partial
 
 import numpy as np
 
@@ -58,13 +54,9 @@ __all__ = ["MISFIT_LIMIT", "split_contact"]
 #: fruit landing within a fraction of a time to peak leave 2–10 %.
 MISFIT_LIMIT = 0.018
 #: Starts fitted: a contact held for two pulses (a dip or a misfit), and one that one pulse fits but in which a
-#: rebound is due (``FITS_DUE``: most contacts of a busy line; each fit costs 2–5 ms).
+#: rebound is due (``FITS_DUE``: most contacts of a busy line; each fit costs 0.3–1.4 ms, hot).
 FITS = 4
 FITS_DUE = 4
-#: Joint fits run side by side, each start on its own thread (the compiled iteration releases the GIL): as many
-#: as the process may use cores, up to ``FITS``.  The results are taken in the starts' order, whatever finishes
-#: first, so the choice is the one a single thread makes (1: one after the other, on the calling thread).
-PARALLEL_FITS = min(FITS, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 #: A fit whose prior χ² (three parameters) is within this (the 95 % point of χ² with 3 degrees of freedom) agrees
 #: with the expected rebound.
 PLAUSIBLE_PRIOR_CHI2 = 7.81
@@ -128,17 +120,15 @@ def split_contact(time, force, noise: float, *, velocity=None, mass=None, diamet
     weights = np.full(ts.shape, 1.0 / noise)
     args = (velocity if mass is None else None, mass, diameter, poisson)
     found = []
-    starts = joint_starts(ts, y, noise, landmarks(y) if dip else None, expected, fits)
-    with closing(_in_order([partial(_joint_fit, ts, y, weights, theta, prior) for theta, prior in starts])) as fitted:
-        for (_, prior), result in zip(starts, fitted):
-            fit = _separated(model, ts, y, noise, result, prior)
-            if fit is None:
-                continue
-            found.append(fit)
-            prior_chi2 = prior.chi2(fit[2]) if prior is not None else math.inf
-            if prior_chi2 <= PLAUSIBLE_PRIOR_CHI2 and fit[1] <= GOOD_MISFIT \
-                    and fit[0] - prior_chi2 <= ts.size + NOISE_CHI2_SD * math.sqrt(2.0 * ts.size):
-                break  # it leaves only the noise and one pulse is the rebound that was due: taken (latency)
+    for theta, prior in joint_starts(ts, y, noise, landmarks(y) if dip else None, expected, fits):
+        fit = _separated(model, ts, y, noise, weights, theta, prior)
+        if fit is None:
+            continue
+        found.append(fit)
+        prior_chi2 = prior.chi2(fit[2]) if prior is not None else math.inf
+        if prior_chi2 <= PLAUSIBLE_PRIOR_CHI2 and fit[1] <= GOOD_MISFIT \
+                and fit[0] - prior_chi2 <= ts.size + NOISE_CHI2_SD * math.sqrt(2.0 * ts.size):
+            break  # it leaves only the noise and one pulse is the rebound that was due: taken (latency)
     if not found:
         return None
     # the least χ² (with a rebound due, the posterior: the data's χ² and the prior's); of fits alike in it, the one
@@ -163,43 +153,13 @@ def _implausibility(theta, restitution) -> float:
     return sum(max(0.0, restitution - RESTITUTION_SPREAD - restitution_of_x(float(x))) for x in theta[3::4])
 
 
-def _joint_fit(ts, y, weights, theta, prior):
-    """``fit_pulse_sum`` of two pulses from the start ``theta`` with its prior (None: none).  Safe on any thread:
-    it shares no buffer (``_separated`` then judges the result on the calling thread, with the model's)."""
-    with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
-        return fit_pulse_sum(ts, y, weights, theta,
-                             *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
-                             max_iterations=SPLIT_ITERATIONS)
-
-
-_POOL: dict = {}
-
-
-def _in_order(jobs: list):
-    """The results of ``jobs`` (callables) in their order, computed up to ``PARALLEL_FITS`` at a time on worker
-    threads; those not yet begun are cancelled when the caller stops early (``closing``).  A forked child (the web
-    app's workers) gets its own pool: the parent's threads do not exist there."""
-    if PARALLEL_FITS < 2 or len(jobs) < 2:
-        for job in jobs:
-            yield job()
-        return
-    pool = _POOL.get(os.getpid())
-    if pool is None:
-        _POOL.clear()
-        pool = _POOL[os.getpid()] = ThreadPoolExecutor(PARALLEL_FITS, thread_name_prefix="fruitimpact-fit")
-    futures = [pool.submit(job) for job in jobs]
-    try:
-        for future in futures:
-            yield future.result()
-    finally:
-        for future in futures:
-            future.cancel()
-
-
-def _separated(model, ts, y, noise, result, prior=None):
-    """(χ², misfit, θ, covariance, rms, iterations) of a joint fit (``_joint_fit``'s result) when it is accepted
+def _separated(model, ts, y, noise, weights, theta, prior=None):
+    """(χ², misfit, θ, covariance, rms, iterations) of the joint fit started at ``theta`` when it is accepted
     (module docstring), else None."""
-    theta, jac, _, iterations, converged, _ = result
+    with np.errstate(all="ignore"):  # a trial step far out (a duration of e^700) is a failed separation
+        theta, jac, _, iterations, converged, _ = fit_pulse_sum(
+            ts, y, weights, theta, *((prior.index, prior.mean, prior.weight) if prior is not None else ()),
+            max_iterations=SPLIT_ITERATIONS)
     if not np.all(np.isfinite(theta)):
         return None
     try:  # a degenerate pulse (a peak or duration beyond double precision) is a failed separation
