@@ -768,7 +768,7 @@ def test_help_and_usage_errors_of_the_console_script_load_neither_numba_nor_nump
       "--sphere-poisson", "0.45"], "argument --sphere-mass: sphere_mass must be a finite number >= 0.001"),
     (["sphere", "LOG", "--sphere", "is-1987", "--sphere-calibration", "missing.csv"],
      "argument --sphere-calibration: cannot read missing.csv"),
-    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500]"),
+    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500)"),
     # a refusal after the lot's constants are validated (they are no longer computed): 0.7 s before
     (["sweep", "--velocity", "0.5:1:3", "--step", "1e-5"], "argument -o/--output: give -o OUT and/or --plot FILE"),
     (["population", "--mass", "sample(missing.csv)"], "argument --mass: sample: no such file 'missing.csv'"),
@@ -784,7 +784,7 @@ def test_a_usage_error_found_by_validating_inputs_starts_no_numba(argv, line, tm
 
 @pytest.mark.parametrize("argv, line", [
     # the rate read from a recording's first rows (Arrow's to_numpy imported pandas: 0.43 s)
-    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500]"),
+    (["analyze", "REC", "--lowpass", "20kHz"], "argument --lowpass: must be a number in (0, 500)"),
     # a sample CSV read with the csv module: a text column, a ragged row (pandas read the file: 0.41 s)
     (["population", "--mass", "sample(fruit.csv:model)"], "argument --mass: sample: column 'model': cannot read"),
     (["population", "--mass", "sample(ragged.csv:mass)"], "argument --mass: sample: line 3 of 'ragged.csv' has 1"),

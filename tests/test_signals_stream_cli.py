@@ -9,6 +9,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from conftest import console_script
 
@@ -168,3 +169,59 @@ def test_stream_equals_analyze_where_a_rebound_is_read_a_second_time(cli, tmp_pa
         assert reader.returncode == 0, reader.stderr
         assert _reports(reader.stdout) == expected, seed
     assert fired == {"reassigned", "held_rebound"}, fired  # both readings happened: the check ran
+
+
+@pytest.mark.parametrize("cutoff", ["10000", "10kHz", "10001"])
+def test_a_lowpass_at_or_above_nyquist_is_refused_with_an_open_range(cutoff):
+    """A Butterworth cutoff must lie below the Nyquist frequency (rate/2): at it the digital design has no
+    pass band.  The refusal states the open range it checks, (0, rate/2), the same for rate/2 itself and beyond
+    (rate/2 had been refused by the detector's check while the option's message said (0, rate/2])."""
+    done = subprocess.run([console_script(), "stream", "--rate", "20000", "--lowpass", cutoff], input=b"0\n0\n",
+                          capture_output=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.decode().strip().splitlines() == [
+        f"fruitimpact stream: error: argument --lowpass: must be a number in (0, 10000); got {cutoff!r}"]
+
+
+@pytest.mark.parametrize("stop, status", [("SIGINT", 130), ("SIGTERM", 0)])
+def test_a_listening_stream_summarises_each_client_and_exits_as_on_stdin(stop, status):
+    """``stream --listen``: each client's stream ends with the line stdin's ends with (samples, impacts, the mains
+    hum --hum auto found), prefixed by the client's address; Ctrl-C (SIGINT) ends the server with 130, as on
+    stdin, and SIGTERM (a server's normal stop) with 0.  The signal is a 60 Hz hum of 0.05 N on quiet noise: a
+    client's line must name 60 Hz (it had printed nothing per client, and exited 0 on Ctrl-C)."""
+    import re
+    import select
+    import signal
+    import socket
+    import time
+
+    from conftest import sigint_default
+
+    rate = 20000
+    t = np.arange(int(0.5 * rate)) / rate
+    noise = np.random.default_rng(3).normal(0.0, 0.002, t.size)
+    samples = (0.05 * np.sin(2 * np.pi * 60 * t) + noise).astype("<f4").tobytes()
+    server = subprocess.Popen([console_script(), "stream", "--rate", str(rate), "--format", "f32", "--listen", "0"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=sigint_default)
+
+    def next_line(seconds=60.0) -> bytes:  # b"" when none came (the old code wrote no line per client)
+        ready, _, _ = select.select([server.stderr], [], [], seconds)
+        return server.stderr.readline() if ready else b""
+
+    try:
+        port = int(re.search(rb"listening on 127\.0\.0\.1:(\d+)", next_line()).group(1))
+        with socket.create_connection(("127.0.0.1", port)) as client:
+            client.sendall(samples)
+        line = next_line().decode()  # the client's summary, once its stream is analysed
+        time.sleep(0.2)
+        server.send_signal(getattr(signal, stop))
+        _, rest = server.communicate(timeout=60)
+    finally:
+        if server.poll() is None:
+            server.kill()
+    found = re.fullmatch(r"fruitimpact stream: client 127\.0\.0\.1:\d+: 10000 samples, 0 impacts; mains hum found "
+                         r"at 60 Hz \((\S+) N on the first 0\.2 s\) and removed \(--hum auto\)\n", line)
+    assert found, line
+    assert float(found.group(1)) == pytest.approx(0.05, rel=0.02)  # its amplitude (noise 0.002 N over 4,000 samples)
+    assert server.returncode == status, rest
+    assert b"Traceback" not in rest

@@ -183,7 +183,7 @@ def cmd_analyze(args) -> int:
         speeds = analyzer.line_speeds()
         if speeds is not None:
             print(_speeds_read(speeds))
-        for line in (_hum_found(analyzer.detector), _discharge_measured(analyzer.discharge_times())):
+        for line in (_hum_found(analyzer.hum_found()), _discharge_measured(analyzer.discharge_times())):
             if line:
                 print(line)
     if args.plot:
@@ -209,13 +209,13 @@ def _speeds_read(speeds: dict) -> str:
     return "impact speed read from each lane's rebounds (no --drop-height given): " + ", ".join(parts)
 
 
-def _hum_found(detector) -> str:
-    """The summary line that says which mains hum ``--hum auto`` found and removed, or "" (none found, or the
-    frequency given)."""
-    if detector.hum_found is None or detector.hum_frequency is None:
+def _hum_found(found: dict | None) -> str:
+    """The summary line that says which mains hum ``--hum auto`` found and removed (``StreamAnalyzer.hum_found``),
+    or "" (none found, or the frequency given)."""
+    if found is None:
         return ""
-    frequency, amplitude, _ = detector.hum_found
-    return f"mains hum found at {frequency:g} Hz ({amplitude:.3g} N on the first 0.2 s) and removed (--hum auto)"
+    return (f"mains hum found at {found['frequency']:g} Hz ({found['amplitude']:.3g} N on the first 0.2 s) "
+            f"and removed (--hum auto)")
 
 
 def _discharge_measured(times: dict | None) -> str:
@@ -459,25 +459,35 @@ def cmd_stream(args) -> int:
             _settle_the_heap()
             print(f"{PROG} stream: listening on 127.0.0.1:{actual}", file=sys.stderr, flush=True)
 
+        def client_done(address, summary):
+            print(f"{PROG} stream: client {address[0]}:{address[1]}: {_summary_text(summary)}", file=sys.stderr,
+                  flush=True)
+
+        stopped: list[str] = []
         try:
             _library_call(serve, port, rate, lanes, settings, emit, source=source, on_problem=problem,
-                          on_listening=listening, analysis=analysis)
+                          on_listening=listening, on_client=client_done, analysis=analysis, on_stop=stopped.append)
         except OSError as error:  # the port taken, or not ours to bind
             raise UsageError(f"argument --listen: cannot listen on 127.0.0.1:{port}: "
                              f"{error.strerror or error}") from None
-        return 0
+        return 130 if stopped == ["SIGINT"] else 0  # Ctrl-C, as on stdin; SIGTERM is a server's normal stop
     analyzer = _library_call(StreamAnalyzer, rate, lanes, settings, emit, source=source, on_problem=problem,
                              analysis=analysis)
     _settle_the_heap()
     summary = _library_call(analyzer.run, iter_chunks(sys.stdin.buffer))
-    found = "; ".join(line for line in (_hum_found(analyzer.detector), _discharge_measured(analyzer.discharge_times()))
-                      if line)
-    print(f"{PROG} stream: {summary['samples']} samples, {summary['impacts']} impacts"
-          + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
-          + (f"; {found}" if found else "")
-          + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""),
-          file=sys.stderr)
+    print(f"{PROG} stream: {_summary_text(summary)}", file=sys.stderr)
     return 130 if summary["interrupted"] == "SIGINT" else 0
+
+
+def _summary_text(summary: dict) -> str:
+    """A stream's summary (``StreamAnalyzer.summary``) as the line ``stream`` ends it with (and, with --listen,
+    each client): samples, impacts, lines skipped, the hum and discharge found, and the signal that stopped it."""
+    found = "; ".join(line for line in (_hum_found(summary["hum_found"]),
+                                        _discharge_measured(summary["discharge_times"])) if line)
+    return (f"{summary['samples']} samples, {summary['impacts']} impacts"
+            + (f", {summary['malformed_lines']} malformed lines skipped" if summary["malformed_lines"] else "")
+            + (f"; {found}" if found else "")
+            + (f"; stopped by {summary['interrupted']}, held impacts flushed" if summary["interrupted"] else ""))
 
 
 def _settle_the_heap() -> None:

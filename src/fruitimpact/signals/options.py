@@ -31,17 +31,19 @@ def _refusal(option: str, text: str) -> InputError:
     return InputError(f"argument {option}: {text}", _NAMES.get(option.split("/")[0]))
 
 
-def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf):
+def _number(option: str, text, dimension: str, low: float = 0.0, low_inclusive: bool = False, high=math.inf,
+            high_inclusive: bool = True):
     if text is None:
         return None
     try:
         value = parse_quantity(text, dimension)
     except ValueError as exc:
         raise _refusal(option, str(exc)) from None
-    ok = (value >= low if low_inclusive else value > low) and value <= high and math.isfinite(value)
+    ok = ((value >= low if low_inclusive else value > low) and (value <= high if high_inclusive else value < high)
+          and math.isfinite(value))
     if not ok:
-        bracket = "[" if low_inclusive else "("
-        raise _refusal(option, f"must be a number in {bracket}{low:.7g}, {high:.7g}]; got {text!r}")
+        opening, closing = "[" if low_inclusive else "(", "]" if high_inclusive else ")"
+        raise _refusal(option, f"must be a number in {opening}{low:.7g}, {high:.7g}{closing}; got {text!r}")
     return value
 
 
@@ -131,7 +133,7 @@ def analysis_settings(rate: float, rate_known: bool = True, **options):
 
     # every plain check first: a usage error is answered before the detector and the fit (numba) are imported
     hum = parse_hum(args.hum)
-    lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0)
+    lowpass = _number("--lowpass", args.lowpass, "frequency", high=rate / 2.0, high_inclusive=False)  # below Nyquist
     clip = parse_clip(args.clip)
     discharge = parse_discharge(args.discharge_time)
     velocity = _number("--velocity", args.velocity, "velocity", high=15.0)  # 15 m/s: an 11 m drop

@@ -410,14 +410,24 @@ class StreamAnalyzer:
             return None
         return {name: self.detector.discharge_time(lane) for lane, name in enumerate(self.lane_names)}
 
+    def hum_found(self) -> dict | None:
+        """The mains hum found on the first samples and removed (``hum_frequency="auto"``): its ``frequency``
+        [Hz] and ``amplitude`` [N]; None when none was found, or the frequency was given or declared none."""
+        found = self.detector.hum_found
+        if found is None or self.detector.hum_frequency is None:
+            return None
+        return {"frequency": float(found[0]), "amplitude": float(found[1])}
+
     def summary(self) -> dict:
-        """Samples per lane, impacts emitted, input problems by kind, and how the stream ended."""
+        """Samples per lane, impacts emitted, input problems by kind, how the stream ended, and what it found of
+        the sensor's chain: the mains hum (``hum_found``) and each lane's discharge (``discharge_times``)."""
         source = self.source
         return {"samples": self.detector.samples_fed, "impacts": self.impacts,
                 "malformed_lines": getattr(source, "malformed", 0),
                 "replaced_values": getattr(source, "replaced", 0),
                 "dropped_bytes": getattr(source, "dropped_bytes", 0),
-                "problems": source.problems, "interrupted": self.interrupted}
+                "problems": source.problems, "interrupted": self.interrupted,
+                "hum_found": self.hum_found(), "discharge_times": self.discharge_times()}
 
 
 def iter_chunks(file, size: int = CHUNK_SIZE):
@@ -436,13 +446,14 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
           max_clients: int | None = None, on_listening: Callable[[int], None] | None = None,
           on_client: Callable[[tuple, dict], None] | None = None,
           on_detected: Callable[[DetectedImpact, dict], None] | None = None,
-          analysis: Analysis | None = None) -> list[dict]:
+          analysis: Analysis | None = None, on_stop: Callable[[str], None] | None = None) -> list[dict]:
     """Listen on ``host``:``port`` (0: any free port) and analyse each client's bytes as one stream, one
     client at a time, until ``max_clients`` clients were served (None: until SIGTERM/SIGINT).
 
     ``on_impact``, ``source``, ``on_problem``, ``on_detected`` and ``analysis`` are those of ``StreamAnalyzer``;
     ``on_listening(port)`` is called once the socket listens; ``on_client(address, summary)`` after each
-    client.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
+    client; ``on_stop(name)`` with the signal's name ("SIGTERM", "SIGINT") when one stops the server, between
+    clients or during one.  Returns the clients' summaries.  Arguments are checked (by building an analyzer) before
     the socket is opened.
     """
     check_integer("port", port, 0, 65535)
@@ -465,9 +476,12 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
                 if on_client is not None:
                     on_client(address, summary)
                 if summary["interrupted"]:
+                    if on_stop is not None:
+                        on_stop(summary["interrupted"])
                     break
-        except _Interrupted:
-            pass
+        except _Interrupted as stop:
+            if on_stop is not None:
+                on_stop(signal.Signals(stop.signum).name)
     return summaries
 
 
