@@ -463,9 +463,9 @@ def serve(port: int, rate: float, lanes: int = 1, settings: DetectorSettings | N
                    analysis=analysis)  # checks the arguments
     summaries: list[dict] = []
     with _SignalGuard() as guard, socket.create_server((host, port)) as server:
-        if on_listening is not None:
-            on_listening(server.getsockname()[1])
-        try:
+        try:  # a signal while the callback runs (the CLI's collection there takes ~40 ms) stops the server
+            if on_listening is not None:
+                on_listening(server.getsockname()[1])
             while max_clients is None or len(summaries) < max_clients:
                 connection, address = server.accept()
                 with connection:
