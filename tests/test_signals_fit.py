@@ -571,5 +571,10 @@ def test_the_starts_pair_table_is_linear_least_squares():
         assert np.allclose(np.exp(theta[j, [1, 5]]), peaks, rtol=1e-9)
         assert score[j] == pytest.approx(chi2 + prior, rel=1e-9)
         assert theta[j, 0] == ts[first] and theta[j, 4] == ts[int(table[j, 8])]
+        # each pulse's ln T and x are those of the unit pulse its column was built from (not the table's own columns)
+        for pulse, row in ((0, table[j, 0]), (1, table[j, 1])):
+            duration, x = shapes[int(row) // (grid.size + 1)]
+            assert theta[j, 4 * pulse + 2] == pytest.approx(math.log(duration), abs=1e-12)
+            assert theta[j, 4 * pulse + 3] == x
         checked += 1
     assert checked > 20
